@@ -1,0 +1,447 @@
+//! Fresnel reflectance: exact dielectric and conductor equations, the approximations studied by the
+//! course (§3.4.1: Schlick, Lazányi–Szirmay-Kalos, a 1024-entry per-material table), and measured
+//! metal presets.
+//!
+//! Every evaluation takes the **signed** cosine between the incident direction and the (micro-)normal
+//! of the interface: positive when the light arrives from the side the normal points into (outside,
+//! IOR 1 relative), negative when it arrives from inside (relative IOR inverted; total internal
+//! reflection returns 1). Conductors ignore the sign.
+
+use crate::color::Spectrum;
+use serde::{Deserialize, Serialize};
+use std::sync::Arc;
+
+/// Exact unpolarised Fresnel reflectance of a dielectric interface (Born & Wolf, §1.5.2).
+///
+/// # Arguments
+/// * `cos_i` – signed cosine of the incident angle with the interface normal (see module docs).
+/// * `eta` – relative IOR, inside / outside.
+#[inline]
+pub fn dielectric(cos_i: f32, eta: f32) -> f32 {
+    let (cos_i, eta) = if cos_i < 0.0 {
+        (-cos_i, 1.0 / eta)
+    } else {
+        (cos_i, eta)
+    };
+    let cos_i = cos_i.min(1.0);
+    let sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
+    if sin2_t >= 1.0 {
+        return 1.0;
+    }
+    let cos_t = (1.0 - sin2_t).sqrt();
+    let r_par = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    let r_perp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    (0.5 * (r_par * r_par + r_perp * r_perp)).clamp(0.0, 1.0)
+}
+
+/// Exact unpolarised Fresnel reflectance of a conductor with complex relative IOR `n + i k`, for one
+/// channel. Computed in `f64` complex arithmetic, stable for `k ≫ n` and at grazing incidence
+/// (at `cos_i = 0` both amplitude ratios have modulus exactly 1).
+#[inline]
+pub fn conductor(cos_i: f32, n: f32, k: f32) -> f32 {
+    let c = f64::from(cos_i.abs().min(1.0));
+    let (n, k) = (f64::from(n), f64::from(k));
+    // η² = (n² − k²) + i 2nk ; sin²θt·η² = sin²θi, so η cosθt = sqrt(η² − sin²θi).
+    let s2 = 1.0 - c * c;
+    let (er, ei) = (n * n - k * k - s2, 2.0 * n * k);
+    let m = (er * er + ei * ei).sqrt();
+    let a = (0.5 * (m + er)).max(0.0).sqrt(); // Re sqrt(η² − sin²θ)
+    let b = (0.5 * (m - er)).max(0.0).sqrt(); // Im sqrt(η² − sin²θ)
+    // r⊥ = (cosθ − (a+ib)) / (cosθ + (a+ib))
+    let rs = ((c - a).powi(2) + b * b) / ((c + a).powi(2) + b * b);
+    // r∥ = (η² cosθ − (a+ib)) / (η² cosθ + (a+ib)), with η² = (n²−k²) + i 2nk
+    let (pr, pi) = ((n * n - k * k) * c, 2.0 * n * k * c);
+    let num = (pr - a).powi(2) + (pi - b).powi(2);
+    let den = (pr + a).powi(2) + (pi + b).powi(2);
+    let rp = if den > 0.0 { num / den } else { 1.0 };
+    (0.5 * (rs + rp)).clamp(0.0, 1.0) as f32
+}
+
+/// Schlick's approximation `R0 + (1 − R0)(1 − cos)^5` (Schlick 1994, "An inexpensive BRDF model for
+/// physically-based rendering"), with the transmitted cosine used from the denser side so that total
+/// internal reflection is kept.
+#[inline]
+pub fn schlick_dielectric(cos_i: f32, eta: f32) -> f32 {
+    let r0 = ((eta - 1.0) / (eta + 1.0)).powi(2);
+    let c = if cos_i >= 0.0 {
+        cos_i.min(1.0)
+    } else {
+        // From inside: use the outside angle, or TIR.
+        let sin2_t = (1.0 - cos_i * cos_i) * eta * eta;
+        if sin2_t >= 1.0 {
+            return 1.0;
+        }
+        (1.0 - sin2_t).sqrt()
+    };
+    r0 + (1.0 - r0) * (1.0 - c).powi(5)
+}
+
+/// Lazányi & Szirmay-Kalos's approximation for metals (course ref. [23], WSCG 2005, eq. 6 without
+/// the fitted correction term): `((n−1)² + 4n(1−cos)^5 + k²) / ((n+1)² + k²)`.
+#[inline]
+pub fn lazanyi(cos_i: f32, n: f32, k: f32) -> f32 {
+    let c = cos_i.abs().min(1.0);
+    (((n - 1.0).powi(2) + 4.0 * n * (1.0 - c).powi(5) + k * k) / ((n + 1.0).powi(2) + k * k))
+        .clamp(0.0, 1.0)
+}
+
+/// How a material evaluates Fresnel reflectance (course §3.4.1). Never chosen silently: the default
+/// is `Exact`, the rest exist for the accuracy-versus-time study.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum FresnelMode {
+    /// The exact equations.
+    #[default]
+    Exact,
+    /// Schlick's approximation (dielectrics and, with `R0` from `n, k`, conductors).
+    Schlick,
+    /// Lazányi–Szirmay-Kalos (conductors; for dielectrics the same formula with `k = 0`).
+    Lazanyi,
+    /// A 1024-entry table over `cos θ` per side, built once per material from the exact equations
+    /// and linearly interpolated.
+    Table,
+}
+
+/// Entries per side of a [`FresnelTable`].
+pub const TABLE_SIZE: usize = 1024;
+
+/// The course's per-material 1-D Fresnel table (§3.4.1), indexed by `|cos θ|` uniformly; dielectrics
+/// keep one row for light from outside and one from inside (total internal reflection).
+#[derive(Debug, PartialEq)]
+pub struct FresnelTable {
+    outside: Vec<Spectrum>,
+    inside: Vec<Spectrum>,
+}
+
+impl FresnelTable {
+    fn build(exact: &Fresnel) -> Self {
+        let row = |sign: f32| {
+            (0..TABLE_SIZE)
+                .map(|i| exact.eval(sign * i as f32 / (TABLE_SIZE - 1) as f32))
+                .collect::<Vec<_>>()
+        };
+        FresnelTable {
+            outside: row(1.0),
+            inside: row(-1.0),
+        }
+    }
+
+    #[inline]
+    fn lookup(&self, cos_i: f32) -> Spectrum {
+        let row = if cos_i >= 0.0 {
+            &self.outside
+        } else {
+            &self.inside
+        };
+        let x = (cos_i.abs().min(1.0)) * (TABLE_SIZE - 1) as f32;
+        let i = (x as usize).min(TABLE_SIZE - 2);
+        let t = x - i as f32;
+        row[i] * (1.0 - t) + row[i + 1] * t
+    }
+}
+
+/// A Fresnel evaluator bound to one interface, with its approximation chosen.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Fresnel {
+    /// Exact dielectric with relative IOR `eta` (inside / outside).
+    Dielectric {
+        /// Relative IOR.
+        eta: f32,
+    },
+    /// Exact conductor, complex relative IOR per channel.
+    Conductor {
+        /// Real part per channel.
+        n: Spectrum,
+        /// Imaginary part (extinction) per channel.
+        k: Spectrum,
+    },
+    /// A perfect mirror: reflectance 1 at every angle.
+    Perfect,
+    /// Schlick's approximation for a dielectric.
+    SchlickDielectric {
+        /// Relative IOR.
+        eta: f32,
+    },
+    /// Schlick's approximation for a conductor, `R0` from `n, k`.
+    SchlickConductor {
+        /// Normal-incidence reflectance per channel.
+        r0: Spectrum,
+    },
+    /// Lazányi–Szirmay-Kalos.
+    Lazanyi {
+        /// Real part per channel.
+        n: Spectrum,
+        /// Imaginary part per channel.
+        k: Spectrum,
+    },
+    /// A precomputed table of one of the exact forms.
+    Table(Arc<FresnelTable>),
+}
+
+impl Fresnel {
+    /// A dielectric interface with the given relative IOR, evaluated in `mode`.
+    pub fn dielectric(eta: f32, mode: FresnelMode) -> Self {
+        let exact = Fresnel::Dielectric { eta };
+        match mode {
+            FresnelMode::Exact => exact,
+            FresnelMode::Schlick => Fresnel::SchlickDielectric { eta },
+            FresnelMode::Lazanyi => Fresnel::Lazanyi {
+                n: Spectrum::splat(eta),
+                k: Spectrum::ZERO,
+            },
+            FresnelMode::Table => Fresnel::Table(Arc::new(FresnelTable::build(&exact))),
+        }
+    }
+
+    /// A conductor with complex relative IOR `n + i k`, evaluated in `mode`.
+    pub fn conductor(n: Spectrum, k: Spectrum, mode: FresnelMode) -> Self {
+        let exact = Fresnel::Conductor { n, k };
+        match mode {
+            FresnelMode::Exact => exact,
+            FresnelMode::Schlick => Fresnel::SchlickConductor {
+                r0: n.zip(k, |n, k| {
+                    ((n - 1.0).powi(2) + k * k) / ((n + 1.0).powi(2) + k * k)
+                }),
+            },
+            FresnelMode::Lazanyi => Fresnel::Lazanyi { n, k },
+            FresnelMode::Table => Fresnel::Table(Arc::new(FresnelTable::build(&exact))),
+        }
+    }
+
+    /// Reflectance for the signed cosine `cos_i` (see the module docs).
+    #[inline]
+    pub fn eval(&self, cos_i: f32) -> Spectrum {
+        match self {
+            Fresnel::Dielectric { eta } => Spectrum::splat(dielectric(cos_i, *eta)),
+            Fresnel::Conductor { n, k } => Spectrum([
+                conductor(cos_i, n[0], k[0]),
+                conductor(cos_i, n[1], k[1]),
+                conductor(cos_i, n[2], k[2]),
+            ]),
+            Fresnel::Perfect => Spectrum::ONE,
+            Fresnel::SchlickDielectric { eta } => Spectrum::splat(schlick_dielectric(cos_i, *eta)),
+            Fresnel::SchlickConductor { r0 } => {
+                let w = (1.0 - cos_i.abs().min(1.0)).powi(5);
+                *r0 + (Spectrum::ONE - *r0) * w
+            }
+            Fresnel::Lazanyi { n, k } => {
+                if cos_i < 0.0 && k.is_black() {
+                    // A dielectric seen from inside: same formula at the outside angle, or TIR.
+                    Spectrum::splat(schlick_like_inside(cos_i, n[0]))
+                } else {
+                    Spectrum([
+                        lazanyi(cos_i, n[0], k[0]),
+                        lazanyi(cos_i, n[1], k[1]),
+                        lazanyi(cos_i, n[2], k[2]),
+                    ])
+                }
+            }
+            Fresnel::Table(t) => t.lookup(cos_i),
+        }
+    }
+}
+
+fn schlick_like_inside(cos_i: f32, eta: f32) -> f32 {
+    let sin2_t = (1.0 - cos_i * cos_i) * eta * eta;
+    if sin2_t >= 1.0 {
+        return 1.0;
+    }
+    lazanyi((1.0 - sin2_t).sqrt(), eta, 0.0)
+}
+
+/// Metal presets: complex IOR `n + i k` at the wavelengths that stand for the Rec.709 primaries
+/// (≈617, 549 and 471 nm; the tabulated photon energies 2.01, 2.26 and 2.63 eV).
+///
+/// Data sources: gold, silver, copper — P. B. Johnson & R. W. Christy, "Optical constants of the
+/// noble metals", Phys. Rev. B 6, 4370 (1972), table values at those energies; aluminium —
+/// A. D. Rakić, "Algorithm for the determination of intrinsic optical constants of metal films",
+/// Appl. Opt. 34, 4755 (1995); brass (Cu-Zn 70/30) — M. R. Querry, "Optical constants of minerals
+/// and other materials from the millimeter to the ultraviolet", CRDEC-CR-88009 (1987). Values are
+/// rounded to three digits; each preset's normal-incidence reflectance is checked in the tests.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Metal {
+    /// Gold (Au).
+    Gold,
+    /// Silver (Ag).
+    Silver,
+    /// Copper (Cu).
+    Copper,
+    /// Aluminium (Al).
+    Aluminium,
+    /// Brass (Cu-Zn).
+    Brass,
+}
+
+impl Metal {
+    /// Every preset, for listings and tests.
+    pub const ALL: [Metal; 5] = [
+        Metal::Gold,
+        Metal::Silver,
+        Metal::Copper,
+        Metal::Aluminium,
+        Metal::Brass,
+    ];
+
+    /// `(n, k)` per channel, relative to vacuum.
+    pub fn nk(self) -> (Spectrum, Spectrum) {
+        match self {
+            Metal::Gold => (
+                Spectrum::rgb(0.21, 0.43, 1.31),
+                Spectrum::rgb(3.272, 2.455, 1.849),
+            ),
+            Metal::Silver => (
+                Spectrum::rgb(0.06, 0.06, 0.05),
+                Spectrum::rgb(4.152, 3.586, 2.869),
+            ),
+            Metal::Copper => (
+                Spectrum::rgb(0.27, 1.00, 1.22),
+                Spectrum::rgb(3.41, 2.58, 2.42),
+            ),
+            Metal::Aluminium => (
+                Spectrum::rgb(1.27, 0.96, 0.66),
+                Spectrum::rgb(7.30, 6.69, 5.60),
+            ),
+            Metal::Brass => (
+                Spectrum::rgb(0.444, 0.527, 1.094),
+                Spectrum::rgb(3.695, 2.765, 1.829),
+            ),
+        }
+    }
+
+    /// Lower-case name as used in recipes.
+    pub fn name(self) -> &'static str {
+        match self {
+            Metal::Gold => "gold",
+            Metal::Silver => "silver",
+            Metal::Copper => "copper",
+            Metal::Aluminium => "aluminium",
+            Metal::Brass => "brass",
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn dielectric_known_values() {
+        // Normal incidence: ((η−1)/(η+1))².
+        assert!((dielectric(1.0, 1.5) - 0.04).abs() < 1e-6);
+        // Brewster angle: parallel component vanishes, F = r⊥²/2.
+        let tb = 1.5f32.atan();
+        let f = dielectric(tb.cos(), 1.5);
+        let ct = (1.0 - tb.sin().powi(2) / 2.25).sqrt();
+        let rs = (tb.cos() - 1.5 * ct) / (tb.cos() + 1.5 * ct);
+        assert!((f - 0.5 * rs * rs).abs() < 1e-5);
+        // Grazing → 1, TIR from inside → 1, index-matched → 0.
+        assert!((dielectric(1e-7, 1.5) - 1.0).abs() < 1e-5);
+        assert_eq!(dielectric(-0.3, 1.5), 1.0);
+        assert!(dielectric(0.7, 1.0).abs() < 1e-7);
+    }
+
+    #[test]
+    fn dielectric_reciprocal_across_interface() {
+        // F from outside at θi equals F from inside at θt (Stokes relations).
+        for i in 1..89 {
+            let ci = (i as f32).to_radians().cos();
+            let st = (1.0 - ci * ci).sqrt() / 1.7;
+            let ct = (1.0 - st * st).sqrt();
+            assert!((dielectric(ci, 1.7) - dielectric(-ct, 1.7)).abs() < 1e-5);
+        }
+    }
+
+    #[test]
+    fn conductor_limits() {
+        // k = 0 reduces to the dielectric equations.
+        for i in 0..90 {
+            let c = (i as f32).to_radians().cos();
+            assert!(
+                (conductor(c, 1.5, 0.0) - dielectric(c, 1.5)).abs() < 1e-5,
+                "{i}"
+            );
+        }
+        // Normal incidence closed form.
+        let (n, k) = (0.2f32, 3.0f32);
+        let r0 = ((n - 1.0).powi(2) + k * k) / ((n + 1.0).powi(2) + k * k);
+        assert!((conductor(1.0, n, k) - r0).abs() < 1e-6);
+        // Grazing and k ≫ n stay finite and in [0, 1].
+        for &(n, k) in &[(0.05, 10.0), (4.0, 10.0), (0.01, 0.0)] {
+            for &c in &[0.0, 1e-7, 0.5, 1.0] {
+                let f = conductor(c, n, k);
+                assert!((0.0..=1.0).contains(&f) && f.is_finite());
+            }
+            assert!((conductor(0.0, n, k) - 1.0).abs() < 1e-6);
+        }
+    }
+
+    #[test]
+    fn presets_reflect_like_metals() {
+        for m in Metal::ALL {
+            let (n, k) = m.nk();
+            let f = Fresnel::conductor(n, k, FresnelMode::Exact).eval(1.0);
+            assert!(
+                f.min_channel() > 0.35 && f.max_channel() < 1.0,
+                "{m:?} {f:?}"
+            );
+        }
+        let gold = Fresnel::conductor(Metal::Gold.nk().0, Metal::Gold.nk().1, FresnelMode::Exact)
+            .eval(1.0);
+        assert!(
+            gold[0] > gold[1] && gold[1] > gold[2],
+            "gold is yellow: {gold:?}"
+        );
+        let silver = Fresnel::conductor(
+            Metal::Silver.nk().0,
+            Metal::Silver.nk().1,
+            FresnelMode::Exact,
+        )
+        .eval(1.0);
+        assert!(silver.min_channel() > 0.95);
+    }
+
+    #[test]
+    fn approximations_track_exact() {
+        let (n, k) = Metal::Gold.nk();
+        let exact = Fresnel::conductor(n, k, FresnelMode::Exact);
+        for mode in [
+            FresnelMode::Schlick,
+            FresnelMode::Lazanyi,
+            FresnelMode::Table,
+        ] {
+            let approx = Fresnel::conductor(n, k, mode);
+            let mut worst = 0.0f32;
+            for i in 0..=1000 {
+                let c = i as f32 / 1000.0;
+                let d = (approx.eval(c) - exact.eval(c)).map(f32::abs).max_channel();
+                worst = worst.max(d);
+            }
+            let bound = if mode == FresnelMode::Table {
+                1e-4
+            } else {
+                0.12
+            };
+            assert!(worst < bound, "{mode:?}: {worst}");
+        }
+        let exact = Fresnel::dielectric(1.5, FresnelMode::Exact);
+        for mode in [
+            FresnelMode::Schlick,
+            FresnelMode::Lazanyi,
+            FresnelMode::Table,
+        ] {
+            let approx = Fresnel::dielectric(1.5, mode);
+            for i in -1000..=1000 {
+                let c = i as f32 / 1000.0;
+                let d = (approx.eval(c)[0] - exact.eval(c)[0]).abs();
+                // The table's linear interpolation rounds the total-internal-reflection knee
+                // (cos = −0.745 for η 1.5) over one entry.
+                let knee = (c + (1.0f32 - 1.0 / 2.25).sqrt()).abs() < 2.0 / 1023.0;
+                let bound = match mode {
+                    FresnelMode::Table if knee => 0.05,
+                    FresnelMode::Table => 2e-3,
+                    _ => 0.15,
+                };
+                assert!(d < bound, "{mode:?} cos {c}: {d}");
+            }
+        }
+    }
+}

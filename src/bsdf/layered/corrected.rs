@@ -1,0 +1,245 @@
+//! The Corrected model (the default) and the sampling mixture shared with the Course model.
+//!
+//! `f = f_top + T(wi)·T(wo)/η² · a · f_rest(wo', wi') + f_multi(wo, wi)` with `T(w) = 1 − E_top(w)`
+//! (the albedo coupling of Kelemen & Szirmay-Kalos, course ref. [20]) and
+//! `f_multi = q(wo) · ρ̄/(1 − ρ̄ r_int) · T(wi)/(π η²)`, `q(wo) = T(wo) · Q(cos θo')`, where
+//! `Q(μ') = ∫ (1 − T_out(wi')) a f_rest cos θi' dωi'` is the energy the layers below send back up
+//! that the interface returns (internal Fresnel reflection and total internal reflection), `ρ̄` the
+//! cosine-weighted albedo of the layers below with absorption and `r_int = 1 − ∫ T cos/(πη²) dω` the
+//! coat's internal diffuse reflectance. With a white Lambert base and no absorption this gives
+//! albedo exactly `E_top + T = 1` (up to the tables' quadrature error).
+//!
+//! `f_multi` is not exactly reciprocal (`q(wo)` and `T(wi)` differ in shape); the reciprocity test
+//! reports by how much. Sampling picks one of three lobes with weights that depend on `wo` only —
+//! the top lobe's albedo, the single-scatter albedo `T(wo)·(A − Q)` and the multiple lobe's albedo —
+//! so `pdf = Σ w_k p_k` (course eq. 3.6) is exact; the lower lobe's pdf carries the refraction
+//! Jacobian `cos θi / (η² cos θi')`.
+
+use super::{LayeredBsdf, absorption, course};
+use crate::bsdf::table::{Table, for_strata};
+use crate::bsdf::{
+    BsdfSample, Bxdf, Lobe, LobeKind, microfacet::v_cavity_g, refract_macro,
+    sample_cosine_hemisphere,
+};
+use crate::color::Spectrum;
+use crate::sampler::hash_words;
+use glam::{Vec2, Vec3};
+use std::f32::consts::{FRAC_1_PI, PI};
+
+/// `f(wo, wi)` of the Corrected model at stack level `l` (`l == coats` = the base).
+pub fn eval(stack: &LayeredBsdf, l: usize, wo: Vec3, wi: Vec3) -> Spectrum {
+    let Some(lv) = stack.levels.get(l) else {
+        return stack.base.eval(wo, wi);
+    };
+    if wo.z <= 0.0 || wi.z <= 0.0 {
+        return Spectrum::ZERO;
+    }
+    let mut f = lv.top.eval(wo, wi);
+    let Some(wo_in) = refract_macro(wo, lv.eta) else {
+        return f;
+    };
+    let (to, ti) = (lv.t(wo.z), lv.t(wi.z));
+    if let Some(wi_in) = refract_macro(wi, lv.eta) {
+        let rest = eval(stack, l + 1, wo_in, wi_in);
+        if !rest.is_black() {
+            let exit = if stack.t_term {
+                let h = (wo + wi).normalize_or_zero();
+                let g = if h.z > 0.0 {
+                    v_cavity_g(wo, wi, h)
+                } else {
+                    1.0
+                };
+                (1.0 - g) + to * g
+            } else {
+                to
+            };
+            f += rest * absorption(lv.od, wo_in.z, wi_in.z) * (ti * exit / (lv.eta * lv.eta));
+        }
+    }
+    f + lv.trapped.at(wo_in.z) * lv.multi_scale * (to * ti)
+}
+
+/// Evaluates level `l` under the analytic model selected by `corrected`.
+#[inline]
+fn eval_model(stack: &LayeredBsdf, l: usize, wo: Vec3, wi: Vec3, corrected: bool) -> Spectrum {
+    if corrected {
+        eval(stack, l, wo, wi)
+    } else {
+        course::eval(stack, l, wo, wi)
+    }
+}
+
+/// Lobe-selection weights `[top, rest, multiple]` at level `l` for `wo` (sum 1, or all 0 when the
+/// level reflects nothing), and the refracted `wo'`.
+#[inline]
+fn lobe_weights(
+    stack: &LayeredBsdf,
+    l: usize,
+    wo: Vec3,
+    corrected: bool,
+) -> ([f32; 3], Option<Vec3>) {
+    let lv = &stack.levels[l];
+    let e = lv.e_top.at(wo.z)[0].max(0.0);
+    let wo_in = refract_macro(wo, lv.eta);
+    let mut w = [e, 0.0, 0.0];
+    if let Some(wi) = wo_in {
+        let t = 1.0 - e;
+        let a = lv.albedo_rest.at(wi.z);
+        let q = lv.trapped.at(wi.z);
+        if corrected {
+            w[1] = t * (a - q).luminance().max(0.0);
+            w[2] = t * (q * lv.multi_albedo).luminance().max(0.0);
+        } else {
+            w[1] = t * a.luminance().max(0.0);
+        }
+    }
+    let sum = w[0] + w[1] + w[2];
+    if sum > 0.0 && sum.is_finite() {
+        (w.map(|x| x / sum), wo_in)
+    } else {
+        ([0.0; 3], wo_in)
+    }
+}
+
+/// Density of the shared mixture at level `l`.
+pub fn pdf(stack: &LayeredBsdf, l: usize, wo: Vec3, wi: Vec3, corrected: bool) -> f32 {
+    let Some(lv) = stack.levels.get(l) else {
+        return stack.base.pdf(wo, wi);
+    }; // pdf is unaffected by compensation
+    if wo.z <= 0.0 || wi.z <= 0.0 {
+        return 0.0;
+    }
+    let (w, wo_in) = lobe_weights(stack, l, wo, corrected);
+    let mut p = 0.0;
+    if w[0] > 0.0 {
+        p += w[0] * lv.top.pdf(wo, wi);
+    }
+    if w[1] > 0.0
+        && let (Some(wo_in), Some(wi_in)) = (wo_in, refract_macro(wi, lv.eta))
+    {
+        let jacobian = wi.z / (lv.eta * lv.eta * wi_in.z);
+        p += w[1] * pdf(stack, l + 1, wo_in, wi_in, corrected) * jacobian;
+    }
+    p += w[2] * wi.z * FRAC_1_PI;
+    if p.is_finite() { p } else { 0.0 }
+}
+
+/// Samples a direction from the mixture at level `l` (no evaluation).
+fn sample_dir(
+    stack: &LayeredBsdf,
+    l: usize,
+    wo: Vec3,
+    uc: f32,
+    u: Vec2,
+    corrected: bool,
+) -> Option<(Vec3, Lobe)> {
+    let Some(lv) = stack.levels.get(l) else {
+        let s = stack.base.sample(wo, uc, u)?;
+        return Some((
+            s.wi,
+            Lobe {
+                kind: s.lobe.kind,
+                layer: l as u8,
+            },
+        ));
+    };
+    if wo.z <= 0.0 {
+        return None;
+    }
+    let (w, wo_in) = lobe_weights(stack, l, wo, corrected);
+    let uc = uc.clamp(0.0, 1.0);
+    if uc < w[0] || (w[1] == 0.0 && w[2] == 0.0) {
+        if w[0] == 0.0 {
+            return None;
+        }
+        let s = lv.top.sample(wo, (uc / w[0]).min(1.0), u)?;
+        return Some((
+            s.wi,
+            Lobe {
+                kind: LobeKind::Glossy,
+                layer: l as u8,
+            },
+        ));
+    }
+    if uc < w[0] + w[1] || w[2] == 0.0 {
+        let uc2 = ((uc - w[0]) / w[1]).clamp(0.0, 1.0);
+        let (wi_in, lobe) = sample_dir(stack, l + 1, wo_in?, uc2, u, corrected)?;
+        let wi = refract_macro(wi_in, 1.0 / lv.eta)?;
+        return Some((wi, lobe));
+    }
+    let wi = sample_cosine_hemisphere(u)?;
+    Some((
+        wi,
+        Lobe {
+            kind: LobeKind::Multiple,
+            layer: l as u8,
+        },
+    ))
+}
+
+/// Samples the analytic model (`corrected` selects Corrected vs Course evaluation) at level `l`.
+pub fn sample(
+    stack: &LayeredBsdf,
+    l: usize,
+    wo: Vec3,
+    uc: f32,
+    u: Vec2,
+    corrected: bool,
+) -> Option<BsdfSample> {
+    let (wi, lobe) = sample_dir(stack, l, wo, uc, u, corrected)?;
+    let f = eval_model(stack, l, wo, wi, corrected);
+    BsdfSample::from_eval(wi, f, pdf(stack, l, wo, wi, corrected), lobe)
+}
+
+/// Builds the tables of level `l` (the levels below must be built already): `E_top`, then `A` and
+/// `Q` by stratified Monte Carlo over the Corrected sampling of the layers below, then `ρ̄`, `r_int`
+/// and the multiple lobe's constants.
+pub(super) fn build_tables(stack: &mut LayeredBsdf, l: usize, grid: usize) {
+    let n2 = (grid * grid) as f32;
+    let top = stack.levels[l].top.clone();
+    stack.levels[l].e_top = Table::by_sampling(grid, hash_words(&[l as u64, 1]), |wo, uc, u| {
+        top.sample(wo, uc, u)
+            .map_or(Spectrum::ZERO, |s| s.weight.map(|w| w.min(1e3)))
+    })
+    .map(|e| e.min(1.0));
+
+    let (eta, od) = (stack.levels[l].eta, stack.levels[l].od);
+    let this = &*stack;
+    let mut trapped_entries = Vec::new();
+    let albedo_rest = Table::build(|mu| {
+        let wo_in = Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
+        let (mut a, mut q) = (Spectrum::ZERO, Spectrum::ZERO);
+        for_strata(
+            grid,
+            hash_words(&[l as u64, 2, u64::from(mu.to_bits())]),
+            |uc, u| {
+                if let Some(s) = sample(this, l + 1, wo_in, uc, u, true) {
+                    let wa = s.weight * absorption(od, mu, s.wi.z);
+                    let t_out =
+                        refract_macro(s.wi, 1.0 / eta).map_or(0.0, |wi| this.levels[l].t(wi.z));
+                    a += wa;
+                    q += wa * (1.0 - t_out);
+                }
+            },
+        );
+        trapped_entries.push(q / n2);
+        a / n2
+    });
+    let mut it = trapped_entries.into_iter();
+    let trapped = Table::build(|_| it.next().unwrap_or(Spectrum::ZERO));
+
+    let lv = &stack.levels[l];
+    let t_table = Table::build(|mu| Spectrum::splat(lv.t(mu)));
+    let r_int = (1.0 - t_table.hemispherical(|_| 1.0)[0] / (eta * eta)).clamp(0.0, 1.0);
+    let rho_bar = albedo_rest
+        .hemispherical(|_| 1.0)
+        .map(|x| x.clamp(0.0, 1.0));
+    let denom = (Spectrum::ONE - rho_bar * r_int).map(|d| d.max(1e-6));
+    let multi_scale = rho_bar.zip(denom, |r, d| r / d / (PI * eta * eta));
+    let multi_albedo = rho_bar.zip(denom, |r, d| r * (1.0 - r_int) / d);
+    let lv = &mut stack.levels[l];
+    lv.albedo_rest = albedo_rest;
+    lv.trapped = trapped;
+    lv.multi_scale = multi_scale;
+    lv.multi_albedo = multi_albedo;
+}

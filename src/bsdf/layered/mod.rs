@@ -1,0 +1,425 @@
+//! The Weidlich–Wilkie layer stack (course §3.1–3.2; DESIGN §3.2): rough dielectric coats with
+//! absorbing varnish over one opaque base, evaluated by one of three [`Model`]s.
+//!
+//! - [`Model::Course`] — eqs. 3.1–3.3 exactly as published ([`course`]).
+//! - [`Model::Corrected`] — the default: the same structure with the `1/η²` solid-angle compression,
+//!   albedo-coupled transmission `T = 1 − E_top` and a multiple-internal-reflection lobe
+//!   ([`corrected`]).
+//! - [`Model::Reference`] — a position-free Monte Carlo random walk through the same stack
+//!   ([`reference`]), the yardstick for the other two.
+//!
+//! Directions below the top coat are obtained by refracting through the **macro (shading) normal**
+//! ([`super::refract_macro`]), not through a sampled micro-normal. This is a deliberate choice: the
+//! map `w ↦ w'` is then a fixed bijection between the outside hemisphere and the inner cone, so
+//! `eval`, `sample` and `pdf` of the analytic models describe one and the same density, the lower
+//! lobes' pdf carries the exact Jacobian `|dωi'/dωi| = cos θi / (η² cos θi')`, and chi-square tests
+//! apply. Inner directions outside the cone (beyond the critical angle) cannot leave: a sample that
+//! lands there fails, and its energy is what the multiple-reflection lobe (Corrected) or the `t`
+//! term (Course) stands in for.
+
+pub mod corrected;
+pub mod course;
+pub mod reference;
+
+use super::table::Table;
+use super::{
+    Bsdf, BsdfSample, Bxdf, Distribution, Fresnel, FresnelMode, Lambert, MicrofacetDistribution,
+    OrenNayar, RoughDielectric, TorranceSparrow,
+};
+use crate::color::Spectrum;
+use glam::{Vec2, Vec3};
+use serde::{Deserialize, Serialize};
+
+/// One coat of a stack: a rough dielectric interface and the varnish below it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Coat {
+    /// Absolute IOR of the varnish (the medium above the top coat is air, IOR 1).
+    pub ior: f32,
+    /// RMS micro-facet slope angle of the interface, degrees (0 < m < 90).
+    pub roughness: f32,
+    /// Absorption coefficient per unit thickness, per channel (≥ 0).
+    pub absorption: Spectrum,
+    /// Layer thickness in the course's arbitrary units (≥ 0).
+    pub thickness: f32,
+}
+
+/// A conductor's complex IOR, absolute.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ConductorIor {
+    /// `n + i k` per channel.
+    Complex {
+        /// Real part.
+        n: Spectrum,
+        /// Extinction coefficient.
+        k: Spectrum,
+    },
+    /// Reflectance 1 at every angle (a perfect mirror; for furnace tests).
+    Perfect,
+}
+
+/// The opaque base of a stack.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Base {
+    /// Lambertian, albedo per channel.
+    Lambert {
+        /// Albedo (0 … 1).
+        albedo: Spectrum,
+    },
+    /// Oren–Nayar.
+    OrenNayar {
+        /// Albedo (0 … 1).
+        albedo: Spectrum,
+        /// Slope standard deviation, radians.
+        sigma: f32,
+    },
+    /// A rough conductor (Torrance–Sparrow).
+    Conductor {
+        /// Complex IOR, absolute (relative IORs against the varnish are formed at build time).
+        ior: ConductorIor,
+        /// RMS slope angle, degrees.
+        roughness: f32,
+    },
+}
+
+/// Parameters of the Reference random walk.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct ReferenceParams {
+    /// Independent walks averaged by one `eval` (≥ 1).
+    pub samples: u32,
+    /// Maximum number of bounces at the base per walk (Russian roulette usually ends walks earlier).
+    pub max_depth: u32,
+}
+
+impl Default for ReferenceParams {
+    fn default() -> Self {
+        ReferenceParams {
+            samples: 4,
+            max_depth: 32,
+        }
+    }
+}
+
+/// Which evaluation model a stack uses (DESIGN §3.2).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Model {
+    /// Course eqs. 3.1–3.3 as published.
+    Course,
+    /// Energy-consistent local model (default).
+    #[default]
+    Corrected,
+    /// Stochastic random walk.
+    Reference(ReferenceParams),
+}
+
+/// Everything that defines a stack at runtime, before its tables are built.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StackDesc {
+    /// Coats, top first (may be empty: then the stack is its base).
+    pub coats: Vec<Coat>,
+    /// The opaque base.
+    pub base: Base,
+    /// Evaluation model.
+    pub model: Model,
+    /// Fresnel evaluation for the Torrance–Sparrow lobes.
+    pub fresnel: FresnelMode,
+    /// Micro-facet distribution for all interfaces.
+    pub distribution: Distribution,
+    /// The course's internal-reflection term `t` (eq. 3.3); `None` = the model's default (on for
+    /// Course, off for Corrected; the Reference has no such term).
+    pub t_term: Option<bool>,
+    /// Multiple-scattering energy compensation (Turquin 2019) of a conductor base (Corrected and
+    /// Reference) and of the coats' interfaces (Reference). The Course model never uses it.
+    pub compensation: bool,
+}
+
+impl StackDesc {
+    /// A stack with the default model, exact Fresnel and Blinn distribution.
+    pub fn new(coats: Vec<Coat>, base: Base) -> Self {
+        StackDesc {
+            coats,
+            base,
+            model: Model::default(),
+            fresnel: FresnelMode::Exact,
+            distribution: Distribution::Blinn,
+            t_term: None,
+            compensation: true,
+        }
+    }
+    /// The same stack under another model.
+    pub fn with_model(mut self, model: Model) -> Self {
+        self.model = model;
+        self
+    }
+}
+
+/// Why a stack description cannot be built.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum StackError {
+    /// A parameter is outside its allowed range.
+    #[error("{what} = {value} is out of range: allowed {range}")]
+    OutOfRange {
+        /// Which parameter.
+        what: String,
+        /// The offending value.
+        value: f32,
+        /// The allowed range, in words.
+        range: &'static str,
+    },
+}
+
+/// Runtime data of one coat as seen from above.
+#[derive(Clone, Debug)]
+pub(crate) struct Level {
+    /// Relative IOR below / above.
+    pub eta: f32,
+    /// The interface's reflection lobe, with the material's Fresnel mode.
+    pub top: TorranceSparrow,
+    /// Macro-normal Fresnel for the Course model's `T12`, `T21`.
+    pub fresnel: Fresnel,
+    /// The interface with transmission (exact Fresnel), for the Reference walk.
+    pub interface: RoughDielectric,
+    /// `η = 1` exactly: the interface is invisible and does not deflect light.
+    pub index_matched: bool,
+    /// Optical depth `α·d` at normal incidence, per channel.
+    pub od: Spectrum,
+    /// Directional albedo of `top`, over `cos θo` outside.
+    pub e_top: Table,
+    /// `A(μ') = ∫ a(w',wi') f_rest(w',wi') cos θi' dωi'` over the inner `cos θ'`.
+    pub albedo_rest: Table,
+    /// `Q(μ') = ∫ (1 − T_out(wi')) a f_rest cos θi' dωi'`: what the interface sends back down.
+    pub trapped: Table,
+    /// `ρ̄ / (1 − ρ̄ r_int) / (π η²)`: the multiple-reflection lobe's scale.
+    pub multi_scale: Spectrum,
+    /// Fraction of `q` that leaves after the inner bounces: `ρ̄ (1 − r_int) / (1 − ρ̄ r_int)`.
+    pub multi_albedo: Spectrum,
+}
+
+impl Level {
+    /// Transmission into the layer, `T(w) = 1 − E_top(w)`.
+    #[inline]
+    pub fn t(&self, cos: f32) -> f32 {
+        (1.0 - self.e_top.at(cos)[0]).clamp(0.0, 1.0)
+    }
+}
+
+/// Absorption along the two inner legs, `exp(−α d (1/cos θi' + 1/cos θo'))` (course eq. 3.2); 0
+/// (never NaN) when the optical depth is huge or a leg is grazing.
+#[inline]
+pub fn absorption(od: Spectrum, cos_a: f32, cos_b: f32) -> Spectrum {
+    let path = 1.0 / cos_a.abs().max(1e-12) + 1.0 / cos_b.abs().max(1e-12);
+    od.map(|o| if o == 0.0 { 1.0 } else { (-o * path).exp() })
+}
+
+/// Transmittance of one inner leg, `exp(−α d / |cos θ|)`.
+#[inline]
+pub fn transmittance(od: Spectrum, cos: f32) -> Spectrum {
+    let path = 1.0 / cos.abs().max(1e-12);
+    od.map(|o| if o == 0.0 { 1.0 } else { (-o * path).exp() })
+}
+
+/// A compiled layer stack: the material interface of lapidary.
+#[derive(Clone, Debug)]
+pub struct LayeredBsdf {
+    pub(crate) levels: Box<[Level]>,
+    /// The base as used by Corrected and Reference (compensated when asked).
+    pub(crate) base: Bsdf,
+    /// The base as the course defines it (never compensated), used by Course.
+    pub(crate) base_plain: Bsdf,
+    pub(crate) model: Model,
+    pub(crate) t_term: bool,
+    pub(crate) compensation: bool,
+}
+
+/// MC samples per table entry (a stratified `n × n` grid).
+const TABLE_GRID: usize = 40;
+
+impl LayeredBsdf {
+    /// Validates `desc` and builds its runtime tables (a few milliseconds per coat).
+    pub fn new(desc: &StackDesc) -> Result<Self, StackError> {
+        validate(desc)?;
+        let mut above = 1.0f32;
+        let mut levels = Vec::with_capacity(desc.coats.len());
+        for c in &desc.coats {
+            let eta = c.ior / above;
+            above = c.ior;
+            let dist = MicrofacetDistribution::new(desc.distribution, c.roughness);
+            levels.push(Level {
+                eta,
+                top: TorranceSparrow::new(dist, Fresnel::dielectric(eta, desc.fresnel)),
+                fresnel: Fresnel::dielectric(eta, desc.fresnel),
+                interface: RoughDielectric::new(dist, eta),
+                index_matched: (eta - 1.0).abs() < 1e-6,
+                od: c.absorption * c.thickness,
+                e_top: Table::zero(),
+                albedo_rest: Table::zero(),
+                trapped: Table::zero(),
+                multi_scale: Spectrum::ZERO,
+                multi_albedo: Spectrum::ZERO,
+            });
+        }
+        let base = match desc.base {
+            Base::Lambert { albedo } => Bsdf::Lambert(Lambert { albedo }),
+            Base::OrenNayar { albedo, sigma } => Bsdf::OrenNayar(OrenNayar { albedo, sigma }),
+            Base::Conductor { ior, roughness } => {
+                let fresnel = match ior {
+                    ConductorIor::Perfect => Fresnel::Perfect,
+                    ConductorIor::Complex { n, k } => {
+                        Fresnel::conductor(n / above, k / above, desc.fresnel)
+                    }
+                };
+                Bsdf::TorranceSparrow(TorranceSparrow::new(
+                    MicrofacetDistribution::new(desc.distribution, roughness),
+                    fresnel,
+                ))
+            }
+        };
+        let base_plain = base.clone();
+        let base = match base {
+            Bsdf::TorranceSparrow(ts) if desc.compensation => {
+                Bsdf::TorranceSparrow(ts.with_compensation())
+            }
+            b => b,
+        };
+        let t_term = desc.t_term.unwrap_or(matches!(desc.model, Model::Course));
+        let mut stack = LayeredBsdf {
+            levels: levels.into_boxed_slice(),
+            base,
+            base_plain,
+            model: desc.model,
+            t_term,
+            compensation: desc.compensation,
+        };
+        for l in (0..stack.levels.len()).rev() {
+            corrected::build_tables(&mut stack, l, TABLE_GRID);
+        }
+        stack.prepare_model();
+        Ok(stack)
+    }
+
+    /// Builds what the current model needs beyond the shared tables (the interfaces' energy tables
+    /// for a compensated Reference walk).
+    fn prepare_model(&mut self) {
+        if matches!(self.model, Model::Reference(_)) && self.compensation {
+            for lv in self.levels.iter_mut() {
+                if lv.interface.energy.is_none() && !lv.index_matched {
+                    lv.interface = lv.interface.clone().with_energy_tables();
+                }
+            }
+        }
+    }
+
+    /// The evaluation model.
+    pub fn model(&self) -> Model {
+        self.model
+    }
+
+    /// Number of coats.
+    pub fn coats(&self) -> usize {
+        self.levels.len()
+    }
+
+    /// Whether the Course `t` term is applied.
+    pub fn t_term(&self) -> bool {
+        self.t_term
+    }
+
+    /// The same compiled stack evaluated by another model (tables are shared by all models).
+    pub fn with_model(&self, model: Model) -> Self {
+        let mut s = self.clone();
+        s.model = model;
+        s.prepare_model();
+        s
+    }
+}
+
+fn validate(desc: &StackDesc) -> Result<(), StackError> {
+    let bad = |what: String, value: f32, range: &'static str| {
+        Err(StackError::OutOfRange { what, value, range })
+    };
+    for (i, c) in desc.coats.iter().enumerate() {
+        if !(c.ior >= 1.0001 && c.ior <= 10.0) {
+            return bad(format!("coats[{i}].ior"), c.ior, "1.0001 ..= 10");
+        }
+        if !(c.roughness >= 0.01 && c.roughness < 90.0) {
+            return bad(
+                format!("coats[{i}].roughness"),
+                c.roughness,
+                "0.01 ..< 90 degrees",
+            );
+        }
+        if !(c.thickness >= 0.0 && c.thickness.is_finite()) {
+            return bad(format!("coats[{i}].thickness"), c.thickness, "0 ..= finite");
+        }
+        for ch in 0..3 {
+            let a = c.absorption[ch];
+            if !(a >= 0.0 && a.is_finite()) {
+                return bad(format!("coats[{i}].absorption[{ch}]"), a, ">= 0, finite");
+            }
+        }
+    }
+    let check_albedo = |albedo: Spectrum| {
+        for ch in 0..3 {
+            if !(0.0..=1.0).contains(&albedo[ch]) {
+                return bad(format!("base.albedo[{ch}]"), albedo[ch], "0 ..= 1");
+            }
+        }
+        Ok(())
+    };
+    match desc.base {
+        Base::Lambert { albedo } => check_albedo(albedo)?,
+        Base::OrenNayar { albedo, sigma } => {
+            check_albedo(albedo)?;
+            if !(0.0..=1.5).contains(&sigma) {
+                return bad("base.sigma".into(), sigma, "0 ..= 1.5 radians");
+            }
+        }
+        Base::Conductor { ior, roughness } => {
+            if !(roughness >= 0.01 && roughness < 90.0) {
+                return bad("base.roughness".into(), roughness, "0.01 ..< 90 degrees");
+            }
+            if let ConductorIor::Complex { n, k } = ior {
+                for ch in 0..3 {
+                    if !(n[ch] > 0.0 && n[ch] <= 20.0) {
+                        return bad(format!("base.n[{ch}]"), n[ch], "0 <.. 20");
+                    }
+                    if !(k[ch] >= 0.0 && k[ch] <= 20.0) {
+                        return bad(format!("base.k[{ch}]"), k[ch], "0 ..= 20");
+                    }
+                }
+            }
+        }
+    }
+    if let Model::Reference(p) = desc.model
+        && (p.samples == 0 || p.max_depth == 0)
+    {
+        return bad("model.Reference.samples/max_depth".into(), 0.0, ">= 1");
+    }
+    Ok(())
+}
+
+impl Bxdf for LayeredBsdf {
+    #[inline]
+    fn eval(&self, wo: Vec3, wi: Vec3) -> Spectrum {
+        match self.model {
+            Model::Course => course::eval(self, 0, wo, wi),
+            Model::Corrected => corrected::eval(self, 0, wo, wi),
+            Model::Reference(p) => reference::eval(self, p, wo, wi),
+        }
+    }
+    #[inline]
+    fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
+        match self.model {
+            Model::Course => corrected::sample(self, 0, wo, uc, u, false),
+            Model::Corrected => corrected::sample(self, 0, wo, uc, u, true),
+            Model::Reference(p) => reference::sample(self, p, wo, uc, u),
+        }
+    }
+    #[inline]
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        match self.model {
+            Model::Course => corrected::pdf(self, 0, wo, wi, false),
+            Model::Corrected => corrected::pdf(self, 0, wo, wi, true),
+            Model::Reference(_) => reference::pdf(self, wo, wi),
+        }
+    }
+}

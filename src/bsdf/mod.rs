@@ -1,0 +1,349 @@
+//! BSDFs: the components of the course's layered model and the layer stack itself.
+//!
+//! # Conventions (written once, here; DESIGN §2)
+//!
+//! - Directions are unit vectors in the **local shading frame**: `z` is the shading normal and
+//!   `cos θ(w) = w.z`. Nothing in this module knows about world space.
+//! - `wo` points toward the viewer (the path's previous vertex), `wi` toward the light (the sampled
+//!   direction); both point **away** from the surface.
+//! - `eval(wo, wi)` is `f(wo, wi)` in sr⁻¹ and **excludes** the cosine `|wi.z|`.
+//! - `pdf(wo, wi)` is a density per steradian of `wi`.
+//! - `sample(wo, uc, u)` consumes one uniform number `uc` (lobe choice) and two in `u` (direction)
+//!   and returns `Option<BsdfSample>`; the path weight is `f · |wi.z| / pdf`, stored as `weight`.
+//!   `None` means the sample failed (e.g. the reflected direction went below the horizon, or a
+//!   refracted direction inside a coat cannot leave it): the caller terminates or retries the path,
+//!   it never sees a NaN.
+//! - Roughness `m` is the course's **RMS micro-facet slope angle in degrees**; Beckmann
+//!   `α = tan m`, normalised Blinn exponent `e = 2/α² − 2` (Walter et al. 2007, eq. 31), and
+//!   `D(h) = (e+2)/(2π) · cos^e θh` (course eq. 3.7).
+//! - Oren–Nayar `σ` is in radians. IORs are absolute in descriptions and relative (below / above) at
+//!   an interface. Colours are linear Rec.709 [`Spectrum`]s.
+//! - Every result is finite and non-negative for every input the types allow, including grazing
+//!   `cos θ` down to 1e-7, `wo == wi`, `wo == -wi` and `u` exactly 0 or 1 (DESIGN §3.3); whenever
+//!   `f > 0` for a direction that `sample` can produce, its `pdf > 0`.
+
+pub mod dielectric;
+pub mod fresnel;
+pub mod lambert;
+pub mod layered;
+pub mod measure;
+pub mod microfacet;
+pub mod oren_nayar;
+pub mod table;
+pub mod torrance_sparrow;
+
+pub use dielectric::{RoughDielectric, TransportMode};
+pub use fresnel::{Fresnel, FresnelMode, Metal};
+pub use lambert::Lambert;
+pub use layered::{
+    Base, Coat, ConductorIor, LayeredBsdf, Model, ReferenceParams, StackDesc, StackError,
+};
+pub use microfacet::{Distribution, MicrofacetDistribution};
+pub use oren_nayar::OrenNayar;
+pub use torrance_sparrow::TorranceSparrow;
+
+use crate::color::Spectrum;
+use glam::{Vec2, Vec3};
+
+/// Which part of a BSDF produced a sample.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LobeKind {
+    /// A diffuse (Lambert / Oren–Nayar) reflection.
+    Diffuse,
+    /// A micro-facet reflection (Torrance–Sparrow, dielectric or conductor).
+    Glossy,
+    /// A micro-facet transmission through a dielectric interface.
+    Transmission,
+    /// The layer stack's multiple-internal-reflection lobe (Corrected model).
+    Multiple,
+    /// A path of the stochastic Reference random walk.
+    RandomWalk,
+}
+
+/// The lobe of a sample and the layer it comes from (0 = the top coat's interface; the base is at
+/// the index equal to the number of coats).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Lobe {
+    /// What kind of scattering.
+    pub kind: LobeKind,
+    /// Which layer of a stack (0 for single components).
+    pub layer: u8,
+}
+
+/// A sampled direction with everything an integrator needs.
+#[derive(Clone, Copy, Debug)]
+pub struct BsdfSample {
+    /// Sampled direction toward the light, local frame, unit length.
+    pub wi: Vec3,
+    /// `f(wo, wi)`, sr⁻¹, cosine excluded.
+    pub f: Spectrum,
+    /// Density of `wi` per steradian (for the Reference model an approximation, see
+    /// [`layered`]); always `> 0` in a returned sample.
+    pub pdf: f32,
+    /// Path weight `f · |wi.z| / pdf` (for the Reference model the unbiased random-walk weight).
+    pub weight: Spectrum,
+    /// Which lobe produced the sample.
+    pub lobe: Lobe,
+}
+
+impl BsdfSample {
+    /// Builds a sample from an evaluated `f` and `pdf`; `None` unless `pdf > 0` and the result is
+    /// finite, so a returned sample is always usable.
+    #[inline]
+    pub fn from_eval(wi: Vec3, f: Spectrum, pdf: f32, lobe: Lobe) -> Option<Self> {
+        if !(pdf > 0.0 && pdf.is_finite()) || !f.is_valid() {
+            return None;
+        }
+        let weight = f * (wi.z.abs() / pdf);
+        weight.is_valid().then_some(BsdfSample {
+            wi,
+            f,
+            pdf,
+            weight,
+            lobe,
+        })
+    }
+}
+
+/// The interface every reflection model implements. Implementations are plain structs and closed
+/// enums (no trait objects on the hot path); the trait exists so tests and benches can be written
+/// once for all of them.
+pub trait Bxdf {
+    /// `f(wo, wi)` in sr⁻¹, cosine excluded. Zero for directions the model does not scatter into.
+    fn eval(&self, wo: Vec3, wi: Vec3) -> Spectrum;
+    /// Samples `wi` given `wo`.
+    ///
+    /// # Arguments
+    /// * `wo` – direction toward the viewer, local frame.
+    /// * `uc` – uniform number in `[0, 1]` that picks a lobe.
+    /// * `u` – uniform pair in `[0, 1]²` that picks the direction within the lobe.
+    fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample>;
+    /// Density per steradian with which `sample(wo, ·)` produces `wi`.
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32;
+}
+
+/// Every BSDF lapidary knows, as one closed enum (static dispatch on the hot path).
+#[derive(Clone, Debug)]
+pub enum Bsdf {
+    /// Lambertian reflection.
+    Lambert(Lambert),
+    /// Oren–Nayar reflection.
+    OrenNayar(OrenNayar),
+    /// Torrance–Sparrow reflection (dielectric or conductor).
+    TorranceSparrow(TorranceSparrow),
+    /// Rough dielectric with transmission, radiance transport, both lobes.
+    Dielectric(RoughDielectric),
+    /// A layer stack.
+    Layered(Box<LayeredBsdf>),
+}
+
+impl Bxdf for Bsdf {
+    #[inline]
+    fn eval(&self, wo: Vec3, wi: Vec3) -> Spectrum {
+        match self {
+            Bsdf::Lambert(b) => b.eval(wo, wi),
+            Bsdf::OrenNayar(b) => b.eval(wo, wi),
+            Bsdf::TorranceSparrow(b) => b.eval(wo, wi),
+            Bsdf::Dielectric(b) => Spectrum::splat(b.eval(wo, wi, TransportMode::Radiance)),
+            Bsdf::Layered(b) => b.eval(wo, wi),
+        }
+    }
+    #[inline]
+    fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
+        match self {
+            Bsdf::Lambert(b) => b.sample(wo, uc, u),
+            Bsdf::OrenNayar(b) => b.sample(wo, uc, u),
+            Bsdf::TorranceSparrow(b) => b.sample(wo, uc, u),
+            Bsdf::Dielectric(b) => {
+                b.sample(wo, uc, u, TransportMode::Radiance, dielectric::Lobes::All)
+            }
+            Bsdf::Layered(b) => b.sample(wo, uc, u),
+        }
+    }
+    #[inline]
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        match self {
+            Bsdf::Lambert(b) => b.pdf(wo, wi),
+            Bsdf::OrenNayar(b) => b.pdf(wo, wi),
+            Bsdf::TorranceSparrow(b) => b.pdf(wo, wi),
+            Bsdf::Dielectric(b) => b.pdf(wo, wi, dielectric::Lobes::All),
+            Bsdf::Layered(b) => b.pdf(wo, wi),
+        }
+    }
+}
+
+impl From<LayeredBsdf> for Bsdf {
+    fn from(l: LayeredBsdf) -> Bsdf {
+        Bsdf::Layered(Box::new(l))
+    }
+}
+
+/// `cos θ` of a local direction.
+#[inline]
+pub fn cos_theta(w: Vec3) -> f32 {
+    w.z
+}
+
+/// `|cos θ|` of a local direction.
+#[inline]
+pub fn abs_cos_theta(w: Vec3) -> f32 {
+    w.z.abs()
+}
+
+/// `sin² θ` computed from the tangential components, accurate near the normal where `1 − z²`
+/// cancels catastrophically.
+#[inline]
+pub fn sin2_theta(w: Vec3) -> f32 {
+    (w.x * w.x + w.y * w.y).min(1.0)
+}
+
+/// True when both directions are strictly on the same side of the surface.
+#[inline]
+pub fn same_hemisphere(a: Vec3, b: Vec3) -> bool {
+    a.z * b.z > 0.0
+}
+
+/// Mirror reflection of `w` about the unit vector `n`: `2 (w·n) n − w`.
+#[inline]
+pub fn reflect(w: Vec3, n: Vec3) -> Vec3 {
+    2.0 * w.dot(n) * n - w
+}
+
+/// Refraction of `w` (pointing away from the surface, on either side) through the unit normal `n`
+/// with relative IOR `eta` = IOR on the side `n` points into the surface / IOR on `n`'s side.
+/// Returns the transmitted direction (pointing away from the surface on the other side), or `None`
+/// under total internal reflection.
+#[inline]
+pub fn refract(w: Vec3, n: Vec3, eta: f32) -> Option<Vec3> {
+    let mut cos_i = w.dot(n);
+    let (mut eta, mut n) = (eta, n);
+    if cos_i < 0.0 {
+        eta = 1.0 / eta;
+        cos_i = -cos_i;
+        n = -n;
+    }
+    let sin2_i = (1.0 - cos_i * cos_i).max(0.0);
+    let sin2_t = sin2_i / (eta * eta);
+    if sin2_t >= 1.0 {
+        return None;
+    }
+    let cos_t = (1.0 - sin2_t).sqrt();
+    Some((-w / eta + (cos_i / eta - cos_t) * n).normalize())
+}
+
+/// Refracts a local direction through the macro (shading) normal `z` of an interface with relative
+/// IOR `eta` (below / above), keeping the azimuth: an upward direction above becomes the upward
+/// direction below that reaches it, and vice versa. This is the course's construction of `wo'`,
+/// `wi'` (eq. 3.1) and is exactly invertible, which keeps eval, sample and pdf of a stack
+/// consistent. Returns `None` when the direction cannot cross (total internal reflection).
+///
+/// # Arguments
+/// * `w` – upward direction (`w.z > 0`) on one side.
+/// * `eta` – IOR of the side `w` is going to / IOR of the side `w` is on.
+#[inline]
+pub fn refract_macro(w: Vec3, eta: f32) -> Option<Vec3> {
+    let s2 = sin2_theta(w) / (eta * eta);
+    if s2 >= 1.0 {
+        return None;
+    }
+    let scale = 1.0 / eta;
+    let z = (1.0 - s2).sqrt();
+    if z <= 0.0 {
+        return None;
+    }
+    Some(Vec3::new(w.x * scale, w.y * scale, z))
+}
+
+/// Power heuristic with exponent 2 (Veach 1997, §9.2.4) for one sample from each strategy.
+#[inline]
+pub fn power_heuristic(pdf_a: f32, pdf_b: f32) -> f32 {
+    let (a, b) = (pdf_a * pdf_a, pdf_b * pdf_b);
+    if a == 0.0 {
+        return 0.0;
+    }
+    if !a.is_finite() {
+        return if b.is_finite() { 1.0 } else { 0.5 };
+    }
+    a / (a + b)
+}
+
+/// Cosine-weighted hemisphere sample (Malley's method over Shirley–Chiu's concentric disk map).
+/// `None` only when the point lands on the disk's rim (`z = 0`, density 0).
+#[inline]
+pub fn sample_cosine_hemisphere(u: Vec2) -> Option<Vec3> {
+    let (ux, uy) = (2.0 * u.x - 1.0, 2.0 * u.y - 1.0);
+    let (r, phi) = if ux == 0.0 && uy == 0.0 {
+        (0.0, 0.0)
+    } else if ux.abs() > uy.abs() {
+        (ux, std::f32::consts::FRAC_PI_4 * (uy / ux))
+    } else {
+        (
+            uy,
+            std::f32::consts::FRAC_PI_2 - std::f32::consts::FRAC_PI_4 * (ux / uy),
+        )
+    };
+    let (x, y) = (r * phi.cos(), r * phi.sin());
+    let z = (1.0 - x * x - y * y).max(0.0).sqrt();
+    (z > 0.0).then(|| Vec3::new(x, y, z).normalize())
+}
+
+/// Builds a unit direction from spherical angles in radians (`theta` from +z, `phi` from +x).
+#[inline]
+pub fn spherical_direction(theta: f32, phi: f32) -> Vec3 {
+    let (st, ct) = theta.sin_cos();
+    let (sp, cp) = phi.sin_cos();
+    Vec3::new(st * cp, st * sp, ct)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn macro_refraction_inverts() {
+        for &eta in &[1.0001f32, 1.5, 4.0] {
+            for i in 0..90 {
+                let w = spherical_direction((i as f32).to_radians(), 0.7);
+                let inner = refract_macro(w, eta).unwrap();
+                assert!(inner.z > 0.0 && (inner.length() - 1.0).abs() < 1e-5);
+                // Snell: sinθ = η sinθ'.
+                assert!((sin2_theta(w).sqrt() - eta * sin2_theta(inner).sqrt()).abs() < 1e-5);
+                let back = refract_macro(inner, 1.0 / eta).unwrap();
+                assert!((back - w).length() < 1e-4, "eta {eta} theta {i}");
+            }
+        }
+        // Beyond the critical angle from inside: no way out.
+        let inside = spherical_direction(60f32.to_radians(), 0.0);
+        assert!(refract_macro(inside, 1.0 / 1.5).is_none());
+    }
+
+    #[test]
+    fn refract_matches_snell_and_tir() {
+        let n = Vec3::Z;
+        let w = spherical_direction(0.5, 1.0);
+        let t = refract(w, n, 1.5).unwrap();
+        assert!(t.z < 0.0);
+        assert!((sin2_theta(w).sqrt() - 1.5 * sin2_theta(t).sqrt()).abs() < 1e-5);
+        let back = refract(t, n, 1.5).unwrap();
+        assert!((back - w).length() < 1e-5);
+        assert!(refract(spherical_direction(2.0, 0.0), n, 1.5).is_none());
+    }
+
+    #[test]
+    fn cosine_sampler_edges() {
+        for &(a, b) in &[(0.0, 0.0), (1.0, 1.0), (0.5, 0.5), (0.0, 1.0), (1.0, 0.5)] {
+            if let Some(w) = sample_cosine_hemisphere(Vec2::new(a, b)) {
+                assert!(w.z > 0.0 && w.is_finite());
+            }
+        }
+        assert_eq!(sample_cosine_hemisphere(Vec2::splat(0.5)).unwrap(), Vec3::Z);
+    }
+
+    #[test]
+    fn power_heuristic_edges() {
+        assert_eq!(power_heuristic(0.0, 0.0), 0.0);
+        assert_eq!(power_heuristic(1.0, 0.0), 1.0);
+        assert!((power_heuristic(1.0, 1.0) - 0.5).abs() < 1e-7);
+        assert_eq!(power_heuristic(f32::INFINITY, 1.0), 1.0);
+    }
+}

@@ -1,0 +1,34 @@
+//! # lapidary
+//!
+//! A physically based renderer for procedurally textured, aventurescent gemstones, built on the
+//! layered BRDF model of Weidlich & Wilkie (SIGGRAPH Asia 2009 course "Exploring the Potential of
+//! Layered BRDF Models"). This crate holds the reflection models ([`bsdf`]), the colour type
+//! ([`color`]), deterministic random numbers ([`sampler`]), the material description format
+//! ([`recipe`]) and the command-line front end ([`cli`]).
+//!
+//! A coated Lambertian, evaluated by the default (Corrected) model:
+//!
+//! ```
+//! use lapidary::bsdf::{Base, Bxdf, Coat, LayeredBsdf, StackDesc};
+//! use lapidary::color::Spectrum;
+//! use glam::Vec3;
+//!
+//! let coat = Coat { ior: 1.5, roughness: 5.0, absorption: Spectrum::ZERO, thickness: 0.0 };
+//! let stack = LayeredBsdf::new(&StackDesc::new(vec![coat], Base::Lambert { albedo: Spectrum::ONE }))?;
+//! let wo = Vec3::new(0.3, 0.0, 0.954).normalize();
+//! let f = stack.eval(wo, Vec3::Z);
+//! assert!(f.is_valid() && f[0] > 0.0);
+//! // Sampling returns the path weight f·cos/pdf directly.
+//! let s = stack.sample(wo, 0.7, glam::Vec2::new(0.2, 0.4)).expect("a direction");
+//! assert!((s.weight[0] - s.f[0] * s.wi.z / s.pdf).abs() < 1e-5);
+//! # Ok::<(), lapidary::bsdf::StackError>(())
+//! ```
+
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+
+pub mod bsdf;
+pub mod cli;
+pub mod color;
+pub mod recipe;
+pub mod sampler;
