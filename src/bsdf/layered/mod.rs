@@ -332,7 +332,8 @@ impl LayeredBsdf {
     }
 }
 
-fn validate(desc: &StackDesc) -> Result<(), StackError> {
+/// Checks every parameter of `desc` against its allowed range.
+pub fn validate(desc: &StackDesc) -> Result<(), StackError> {
     let bad = |what: String, value: f32, range: &'static str| {
         Err(StackError::OutOfRange { what, value, range })
     };

@@ -1,0 +1,246 @@
+//! Serde description of a layered material (a "stack"), separate from the runtime
+//! [`crate::bsdf::LayeredBsdf`] it compiles into.
+//!
+//! ```ron
+//! (
+//!     coats: [(ior: 1.6, roughness: 12.0, thickness: 0.5)],
+//!     base: Lambert(albedo: Srgb(0.37, 0.09, 0.11)),
+//!     // optional: model: Corrected | Course | Reference(samples: 4, max_depth: 32),
+//!     //           fresnel: Exact | Schlick | Lazanyi | Table, distribution: Blinn | Beckmann,
+//!     //           t_term: true/false, compensation: true/false
+//! )
+//! ```
+
+use super::color::ColorDesc;
+use crate::bsdf::{
+    Base, Coat, ConductorIor, Distribution, FresnelMode, Metal, Model, ReferenceParams, StackDesc,
+};
+use crate::color::Spectrum;
+use serde::{Deserialize, Serialize};
+
+/// One coat: a rough dielectric interface over a varnish layer.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CoatDesc {
+    /// Absolute IOR of the varnish, 1.0001 ..= 10.
+    pub ior: f32,
+    /// RMS micro-facet slope angle in degrees, 0.01 ..< 90.
+    pub roughness: f32,
+    /// Layer thickness (course units, fig. 3.4 uses 0 … 15), ≥ 0. Default 0.
+    #[serde(default)]
+    pub thickness: f32,
+    /// Absorption coefficient per unit thickness per channel (≥ 0); the course's `alpha` (the
+    /// *inverse* of the colour the varnish shows). Exclusive with `tint`.
+    #[serde(default)]
+    pub absorption: Option<ColorDesc>,
+    /// The colour white light keeps after one perpendicular pass through the layer (0 < c ≤ 1);
+    /// converted to `absorption = −ln(tint)/thickness`. Needs `thickness > 0`.
+    #[serde(default)]
+    pub tint: Option<ColorDesc>,
+}
+
+/// A conductor's optical constants.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum MetalDesc {
+    /// Gold (Johnson & Christy 1972).
+    Gold,
+    /// Silver (Johnson & Christy 1972).
+    Silver,
+    /// Copper (Johnson & Christy 1972).
+    Copper,
+    /// Aluminium (Rakić 1995).
+    Aluminium,
+    /// Brass (Querry 1987).
+    Brass,
+    /// A perfect mirror (reflectance 1).
+    Perfect,
+    /// Explicit complex IOR `n + i k` per channel.
+    Complex {
+        /// Real parts (r, g, b), > 0.
+        n: (f32, f32, f32),
+        /// Extinction coefficients (r, g, b), ≥ 0.
+        k: (f32, f32, f32),
+    },
+}
+
+/// The opaque base of a stack.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum BaseDesc {
+    /// Lambertian with albedo 0 ..= 1.
+    Lambert {
+        /// Albedo.
+        albedo: ColorDesc,
+    },
+    /// Oren–Nayar with albedo and slope deviation σ in radians (0 ..= 1.5).
+    OrenNayar {
+        /// Albedo.
+        albedo: ColorDesc,
+        /// σ in radians.
+        sigma: f32,
+    },
+    /// Rough conductor.
+    Conductor {
+        /// Optical constants.
+        metal: MetalDesc,
+        /// RMS slope angle in degrees, 0.01 ..< 90.
+        roughness: f32,
+    },
+}
+
+fn default_samples() -> u32 {
+    ReferenceParams::default().samples
+}
+fn default_depth() -> u32 {
+    ReferenceParams::default().max_depth
+}
+
+/// Evaluation model as written in a recipe.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub enum ModelDesc {
+    /// Course eqs. 3.1–3.3 as published.
+    Course,
+    /// Energy-consistent local model (default).
+    #[default]
+    Corrected,
+    /// Stochastic random walk.
+    Reference {
+        /// Walks per evaluation (default 4).
+        #[serde(default = "default_samples")]
+        samples: u32,
+        /// Maximum bounces per walk (default 32).
+        #[serde(default = "default_depth")]
+        max_depth: u32,
+    },
+}
+
+impl ModelDesc {
+    /// The runtime model.
+    pub fn to_model(&self) -> Model {
+        match *self {
+            ModelDesc::Course => Model::Course,
+            ModelDesc::Corrected => Model::Corrected,
+            ModelDesc::Reference { samples, max_depth } => {
+                Model::Reference(ReferenceParams { samples, max_depth })
+            }
+        }
+    }
+}
+
+fn yes() -> bool {
+    true
+}
+
+/// A layered material.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialDesc {
+    /// Coats, top first (may be empty).
+    #[serde(default)]
+    pub coats: Vec<CoatDesc>,
+    /// The opaque base.
+    pub base: BaseDesc,
+    /// Evaluation model (default Corrected).
+    #[serde(default)]
+    pub model: ModelDesc,
+    /// Fresnel evaluation (default Exact).
+    #[serde(default)]
+    pub fresnel: FresnelMode,
+    /// Micro-facet distribution (default Blinn).
+    #[serde(default)]
+    pub distribution: Distribution,
+    /// The course's `t` term; default: on for Course, off otherwise.
+    #[serde(default)]
+    pub t_term: Option<bool>,
+    /// Multiple-scattering compensation (default true).
+    #[serde(default = "yes")]
+    pub compensation: bool,
+}
+
+impl MaterialDesc {
+    /// Converts to the runtime description, naming the offending field on error.
+    pub fn to_stack(&self) -> Result<StackDesc, String> {
+        let mut coats = Vec::with_capacity(self.coats.len());
+        for (i, c) in self.coats.iter().enumerate() {
+            let absorption = match (&c.absorption, &c.tint) {
+                (Some(_), Some(_)) => {
+                    return Err(format!(
+                        "coats[{i}]: give either `absorption` or `tint`, not both"
+                    ));
+                }
+                (Some(a), None) => a
+                    .to_spectrum()
+                    .map_err(|e| format!("coats[{i}].absorption: {e}"))?,
+                (None, Some(t)) => {
+                    let t = t
+                        .to_spectrum()
+                        .map_err(|e| format!("coats[{i}].tint: {e}"))?;
+                    if !(c.thickness > 0.0) {
+                        return Err(format!(
+                            "coats[{i}].tint needs thickness > 0 (got {})",
+                            c.thickness
+                        ));
+                    }
+                    if t.0.iter().any(|&v| !(v > 0.0 && v <= 1.0)) {
+                        return Err(format!(
+                            "coats[{i}].tint = {:?} is out of range: allowed 0 <.. 1 per channel",
+                            t.0
+                        ));
+                    }
+                    t.map(|v| -v.ln() / c.thickness)
+                }
+                (None, None) => Spectrum::ZERO,
+            };
+            coats.push(Coat {
+                ior: c.ior,
+                roughness: c.roughness,
+                absorption,
+                thickness: c.thickness,
+            });
+        }
+        let base = match &self.base {
+            BaseDesc::Lambert { albedo } => Base::Lambert {
+                albedo: albedo
+                    .to_spectrum()
+                    .map_err(|e| format!("base.albedo: {e}"))?,
+            },
+            BaseDesc::OrenNayar { albedo, sigma } => Base::OrenNayar {
+                albedo: albedo
+                    .to_spectrum()
+                    .map_err(|e| format!("base.albedo: {e}"))?,
+                sigma: *sigma,
+            },
+            BaseDesc::Conductor { metal, roughness } => {
+                let preset = |m: Metal| {
+                    let (n, k) = m.nk();
+                    ConductorIor::Complex { n, k }
+                };
+                let ior = match metal {
+                    MetalDesc::Gold => preset(Metal::Gold),
+                    MetalDesc::Silver => preset(Metal::Silver),
+                    MetalDesc::Copper => preset(Metal::Copper),
+                    MetalDesc::Aluminium => preset(Metal::Aluminium),
+                    MetalDesc::Brass => preset(Metal::Brass),
+                    MetalDesc::Perfect => ConductorIor::Perfect,
+                    MetalDesc::Complex { n, k } => ConductorIor::Complex {
+                        n: Spectrum::rgb(n.0, n.1, n.2),
+                        k: Spectrum::rgb(k.0, k.1, k.2),
+                    },
+                };
+                Base::Conductor {
+                    ior,
+                    roughness: *roughness,
+                }
+            }
+        };
+        Ok(StackDesc {
+            coats,
+            base,
+            model: self.model.to_model(),
+            fresnel: self.fresnel,
+            distribution: self.distribution,
+            t_term: self.t_term,
+            compensation: self.compensation,
+        })
+    }
+}
