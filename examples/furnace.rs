@@ -10,24 +10,56 @@ use lapidary::color::Spectrum;
 
 /// Albedo rows `(stack, model, [(θo, albedo)])` with `n` samples per angle.
 fn furnace(n: u64) -> Vec<(String, String, Vec<(f32, f32)>)> {
-    let clear = |ior, roughness| Coat { ior, roughness, absorption: Spectrum::ZERO, thickness: 0.0 };
+    let clear = |ior, roughness| Coat {
+        ior,
+        roughness,
+        absorption: Spectrum::ZERO,
+        thickness: 0.0,
+    };
     let stacks = [
-        ("white Lambert / clear coat η1.5 m5°", StackDesc::new(vec![clear(1.5, 5.0)], Base::Lambert { albedo: Spectrum::ONE })),
+        (
+            "white Lambert / clear coat η1.5 m5°",
+            StackDesc::new(
+                vec![clear(1.5, 5.0)],
+                Base::Lambert {
+                    albedo: Spectrum::ONE,
+                },
+            ),
+        ),
         (
             "perfect conductor m10° / clear coat η1.7 m7°",
-            StackDesc::new(vec![clear(1.7, 7.0)], Base::Conductor { ior: ConductorIor::Perfect, roughness: 10.0 }),
+            StackDesc::new(
+                vec![clear(1.7, 7.0)],
+                Base::Conductor {
+                    ior: ConductorIor::Perfect,
+                    roughness: 10.0,
+                },
+            ),
         ),
     ];
     let mut rows = Vec::new();
     for (name, desc) in stacks {
         let stack = LayeredBsdf::new(&desc).expect("valid stack");
-        for model in [Model::Course, Model::Corrected, Model::Reference(ReferenceParams::default())] {
+        for model in [
+            Model::Course,
+            Model::Corrected,
+            Model::Reference(ReferenceParams::default()),
+        ] {
             let b = stack.with_model(model);
             let values = [0.0f32, 30.0, 60.0, 75.0, 85.0]
                 .iter()
-                .map(|&t| (t, albedo_by_sampling(&b, direction_deg(t, 0.0), n, 7).mean[0]))
+                .map(|&t| {
+                    (
+                        t,
+                        albedo_by_sampling(&b, direction_deg(t, 0.0), n, 7).mean[0],
+                    )
+                })
                 .collect();
-            let label = format!("{model:?}").split('(').next().unwrap_or("").to_string();
+            let label = format!("{model:?}")
+                .split('(')
+                .next()
+                .unwrap_or("")
+                .to_string();
             rows.push((name.to_string(), label, values));
         }
     }
@@ -36,7 +68,10 @@ fn furnace(n: u64) -> Vec<(String, String, Vec<(f32, f32)>)> {
 
 fn main() {
     for (stack, model, values) in furnace(200_000) {
-        let cells: Vec<String> = values.iter().map(|(t, a)| format!("{t:>2}°: {a:.4}")).collect();
+        let cells: Vec<String> = values
+            .iter()
+            .map(|(t, a)| format!("{t:>2}°: {a:.4}"))
+            .collect();
         println!("{stack:<46} {model:<10} {}", cells.join("  "));
     }
 }

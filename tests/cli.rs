@@ -48,7 +48,20 @@ fn list_prints_the_catalogue_names() {
 
 #[test]
 fn eval_matches_sample_for_the_same_direction() {
-    let s = lapidary(&["brdf", "--material", "sugar", "--wo", "40,30", "--sample", "20", "--seed", "3"], None);
+    let s = lapidary(
+        &[
+            "brdf",
+            "--material",
+            "sugar",
+            "--wo",
+            "40,30",
+            "--sample",
+            "20",
+            "--seed",
+            "3",
+        ],
+        None,
+    );
     assert!(s.status.success(), "{}", text(&s.stderr));
     let rows: Vec<Vec<f64>> = text(&s.stdout)
         .lines()
@@ -58,23 +71,46 @@ fn eval_matches_sample_for_the_same_direction() {
     assert!(rows.iter().all(|r| r.len() == 7));
     let ok: Vec<&Vec<f64>> = rows.iter().filter(|r| r[6] > 0.0).collect();
     assert!(ok.len() >= 15, "most samples succeed");
-    let input: String = ok.iter().map(|r| format!("{} {} {}\n", r[0], r[1], r[2])).collect();
-    let e = lapidary(&["brdf", "--material", "sugar", "--wo", "40,30", "--eval"], Some(&input));
+    let input: String = ok
+        .iter()
+        .map(|r| format!("{} {} {}\n", r[0], r[1], r[2]))
+        .collect();
+    let e = lapidary(
+        &["brdf", "--material", "sugar", "--wo", "40,30", "--eval"],
+        Some(&input),
+    );
     assert!(e.status.success(), "{}", text(&e.stderr));
     for (r, line) in ok.iter().zip(text(&e.stdout).lines()) {
-        let v: Vec<f64> = line.split_whitespace().map(|x| x.parse().unwrap()).collect();
+        let v: Vec<f64> = line
+            .split_whitespace()
+            .map(|x| x.parse().unwrap())
+            .collect();
         let (f, pdf) = (&v[..3], v[3]);
         assert!((pdf - r[6]).abs() <= 1e-4 * pdf, "pdf {pdf} vs {}", r[6]);
         for c in 0..3 {
             let w = f[c] * r[2] / pdf;
-            assert!((w - r[3 + c]).abs() <= 1e-3 * w.abs().max(1e-6), "weight {w} vs {}", r[3 + c]);
+            assert!(
+                (w - r[3 + c]).abs() <= 1e-3 * w.abs().max(1e-6),
+                "weight {w} vs {}",
+                r[3 + c]
+            );
         }
     }
 }
 
 #[test]
 fn albedo_table_has_ninety_rows_with_errors() {
-    let out = lapidary(&["brdf", "--material", "silver_paint", "--albedo", "--samples", "2000"], None);
+    let out = lapidary(
+        &[
+            "brdf",
+            "--material",
+            "silver_paint",
+            "--albedo",
+            "--samples",
+            "2000",
+        ],
+        None,
+    );
     assert!(out.status.success(), "{}", text(&out.stderr));
     let rows: Vec<Vec<f64>> = text(&out.stdout)
         .lines()
@@ -94,15 +130,33 @@ fn albedo_table_has_ninety_rows_with_errors() {
 fn bad_input_gives_clear_errors_not_panics() {
     let out = lapidary(&["brdf", "--material", "sugarr", "--albedo"], None);
     assert_eq!(out.status.code(), Some(1));
-    assert!(text(&out.stderr).contains("did you mean \"sugar\""), "{}", text(&out.stderr));
+    assert!(
+        text(&out.stderr).contains("did you mean \"sugar\""),
+        "{}",
+        text(&out.stderr)
+    );
 
-    let out = lapidary(&["brdf", "--material", "sugar", "--wo", "95", "--albedo"], None);
+    let out = lapidary(
+        &["brdf", "--material", "sugar", "--wo", "95", "--albedo"],
+        None,
+    );
     assert_eq!(out.status.code(), Some(2));
-    assert!(text(&out.stderr).contains("0 ..< 90"), "{}", text(&out.stderr));
+    assert!(
+        text(&out.stderr).contains("0 ..< 90"),
+        "{}",
+        text(&out.stderr)
+    );
 
-    let out = lapidary(&["brdf", "--material", "sugar", "--eval"], Some("0 0 1\n1 2\n"));
+    let out = lapidary(
+        &["brdf", "--material", "sugar", "--eval"],
+        Some("0 0 1\n1 2\n"),
+    );
     assert_eq!(out.status.code(), Some(1));
-    assert!(text(&out.stderr).contains("stdin:2"), "{}", text(&out.stderr));
+    assert!(
+        text(&out.stderr).contains("stdin:2"),
+        "{}",
+        text(&out.stderr)
+    );
 
     let dir = std::env::temp_dir().join(format!("lapidary-cli-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -111,12 +165,19 @@ fn bad_input_gives_clear_errors_not_panics() {
     let out = lapidary(&["brdf", bad.to_str().unwrap(), "--list"], None);
     assert_eq!(out.status.code(), Some(1));
     let err = text(&out.stderr);
-    assert!(err.contains("bad.ron:3:") && err.contains("roughness") && err.contains("90"), "{err}");
+    assert!(
+        err.contains("bad.ron:3:") && err.contains("roughness") && err.contains("90"),
+        "{err}"
+    );
 
     let missing = dir.join("missing.ron");
     let out = lapidary(&["brdf", missing.to_str().unwrap(), "--list"], None);
     assert_eq!(out.status.code(), Some(1));
-    assert!(text(&out.stderr).contains("cannot read"), "{}", text(&out.stderr));
+    assert!(
+        text(&out.stderr).contains("cannot read"),
+        "{}",
+        text(&out.stderr)
+    );
 }
 
 #[test]
@@ -124,12 +185,34 @@ fn plot_writes_a_png_and_a_failed_plot_keeps_the_old_file() {
     let dir = std::env::temp_dir().join(format!("lapidary-plot-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let png = dir.join("brass.png");
-    let out = lapidary(&["brdf", "--material", "brass", "--plot", png.to_str().unwrap(), "--samples", "500", "--walks", "1"], None);
+    let out = lapidary(
+        &[
+            "brdf",
+            "--material",
+            "brass",
+            "--plot",
+            png.to_str().unwrap(),
+            "--samples",
+            "500",
+            "--walks",
+            "1",
+        ],
+        None,
+    );
     assert!(out.status.success(), "{}", text(&out.stderr));
     let bytes = std::fs::read(&png).unwrap();
     assert_eq!(&bytes[1..4], b"PNG");
     // Unknown material: the run fails before writing and the good file stays.
-    let out = lapidary(&["brdf", "--material", "nope", "--plot", png.to_str().unwrap()], None);
+    let out = lapidary(
+        &[
+            "brdf",
+            "--material",
+            "nope",
+            "--plot",
+            png.to_str().unwrap(),
+        ],
+        None,
+    );
     assert_eq!(out.status.code(), Some(1));
     assert_eq!(std::fs::read(&png).unwrap(), bytes);
     let leftovers = std::fs::read_dir(&dir).unwrap().count();

@@ -1,7 +1,9 @@
 //! Rough dielectric interface with reflection **and** transmission (Walter, Marschner, Li &
 //! Torrance, "Microfacet models for refraction through rough surfaces", EGSR 2007, eqs. 16–21),
 //! with the same micro-facet distribution and V-cavity `G` as [`super::TorranceSparrow`], so its
-//! reflection lobe is exactly the Torrance–Sparrow dielectric lobe.
+//! reflection lobe is exactly the Torrance–Sparrow dielectric lobe. Micro-normals are sampled from
+//! the V-cavity's visible normals (see [`super::microfacet`]); `uc` first picks the cavity facet,
+//! then (remapped) reflection versus transmission.
 //!
 //! Used by the Reference layer model's random walk, and later by translucent stones. Directions may
 //! lie on either side; `eta` is the relative IOR of the side below the macro normal (`z < 0`) over
@@ -174,7 +176,7 @@ impl RoughDielectric {
         if pr + pt <= 0.0 {
             return 0.0;
         }
-        let pdf_h = self.distribution.pdf_h(h);
+        let pdf_h = self.distribution.pdf_visible(wo, h);
         let p = if is_reflect {
             pdf_h / (4.0 * wo.dot(h).abs()) * pr / (pr + pt)
         } else {
@@ -200,7 +202,7 @@ impl RoughDielectric {
         if wo.z == 0.0 {
             return None;
         }
-        let h = self.distribution.sample_h(u)?;
+        let (h, uc) = self.distribution.sample_visible(wo, uc, u)?;
         let oh = wo.dot(h);
         if oh * wo.z <= 0.0 {
             return None;

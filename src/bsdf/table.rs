@@ -3,6 +3,7 @@
 use crate::color::Spectrum;
 use crate::sampler::{Rng, hash_words};
 use glam::{Vec2, Vec3};
+use rayon::prelude::*;
 
 /// Entries in every layer table (uniform in `cos θ`).
 pub const ENTRIES: usize = 64;
@@ -29,15 +30,44 @@ impl Table {
         }
     }
 
+    /// A table whose entries are `f(entry_cos(i))`, computed in parallel (rayon); the result does
+    /// not depend on the thread count.
+    pub fn build_par(f: impl Fn(f32) -> Spectrum + Sync) -> Self {
+        let values: Vec<Spectrum> = (0..ENTRIES)
+            .into_par_iter()
+            .map(|i| f(entry_cos(i)))
+            .collect();
+        Table {
+            values: values.into_boxed_slice(),
+        }
+    }
+
+    /// Builds two tables at once from `f(μ) -> (a, b)`, in parallel.
+    pub fn build_pair_par(f: impl Fn(f32) -> (Spectrum, Spectrum) + Sync) -> (Self, Self) {
+        let pairs: Vec<(Spectrum, Spectrum)> = (0..ENTRIES)
+            .into_par_iter()
+            .map(|i| f(entry_cos(i)))
+            .collect();
+        let (a, b): (Vec<_>, Vec<_>) = pairs.into_iter().unzip();
+        (
+            Table {
+                values: a.into_boxed_slice(),
+            },
+            Table {
+                values: b.into_boxed_slice(),
+            },
+        )
+    }
+
     /// A table of directional albedos measured by stratified Monte Carlo: entry `μ` is the mean of
-    /// `weight(wo, uc, u)` over a jittered `grid × grid` set of `u` (and random `uc`), with
-    /// `wo = (√(1−μ²), 0, μ)`. Deterministic for a given `key`.
+    /// `weight(wo, uc, u)` over [`for_strata`] with `wo = (√(1−μ²), 0, μ)`. Deterministic for a
+    /// given `key`, whatever the thread count.
     pub fn by_sampling(
         grid: usize,
         key: u64,
-        weight: impl Fn(Vec3, f32, Vec2) -> Spectrum,
+        weight: impl Fn(Vec3, f32, Vec2) -> Spectrum + Sync,
     ) -> Self {
-        Table::build(|mu| {
+        Table::build_par(|mu| {
             let wo = Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
             let mut sum = Spectrum::ZERO;
             for_strata(
@@ -45,7 +75,7 @@ impl Table {
                 hash_words(&[key, u64::from(mu.to_bits())]),
                 |uc, u| sum += weight(wo, uc, u),
             );
-            sum / (grid * grid) as f32
+            sum / (grid * grid * UC_STRATA) as f32
         })
     }
 
@@ -87,8 +117,13 @@ impl Table {
     }
 }
 
-/// Calls `f(uc, u)` for one jittered point in each cell of a `grid × grid` stratification of
-/// `[0, 1)²`, with an independent uniform `uc`; the jitter comes from a stream keyed by `key`.
+/// Strata of `uc` per cell of [`for_strata`].
+pub const UC_STRATA: usize = 4;
+
+/// Calls `f(uc, u)` for a jittered point in each cell of a `grid × grid` stratification of
+/// `[0, 1)²`, once for each of [`UC_STRATA`] jittered strata of `uc` (the lobe or micro-facet
+/// choice), so discrete choices made with `uc` are averaged rather than sampled. The jitter comes
+/// from a stream keyed by `key`. `f` is called `grid² · UC_STRATA` times.
 pub fn for_strata(grid: usize, key: u64, mut f: impl FnMut(f32, Vec2)) {
     let mut rng = Rng::new(key);
     let g = grid as f32;
@@ -98,7 +133,9 @@ pub fn for_strata(grid: usize, key: u64, mut f: impl FnMut(f32, Vec2)) {
                 (i as f32 + rng.uniform()) / g,
                 (j as f32 + rng.uniform()) / g,
             );
-            f(rng.uniform(), u);
+            for k in 0..UC_STRATA {
+                f((k as f32 + rng.uniform()) / UC_STRATA as f32, u);
+            }
         }
     }
 }

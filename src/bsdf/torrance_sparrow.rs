@@ -1,7 +1,8 @@
 //! Torrance–Sparrow micro-facet reflection (course eq. 2.1, §3.3.1):
 //! `f = F(wi·h) D(h) G / (4 |cos θo| |cos θi|)` with the V-cavity `G`, for dielectric and conductor
-//! interfaces alike (the [`Fresnel`] decides which). Sampling draws `h` from `D(h) cos θh` and
-//! reflects `wo`; `pdf = D(h) cos θh / (4 |wo·h|)`.
+//! interfaces alike (the [`Fresnel`] decides which). Sampling draws a visible normal of the V-cavity
+//! model ([`MicrofacetDistribution::sample_visible`]) and reflects `wo`:
+//! `pdf = G1(wo, h) D(h) / (4 cos θo)`, weight `F G / G1 ≤ F`.
 //!
 //! Optionally the lobe carries a multiple-scattering energy compensation (Turquin, "Practical
 //! multiple scattering compensation for microfacet models", 2019, eq. 15):
@@ -106,11 +107,11 @@ impl Bxdf for TorranceSparrow {
     }
 
     #[inline]
-    fn sample(&self, wo: Vec3, _uc: f32, u: Vec2) -> Option<BsdfSample> {
+    fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
         if wo.z <= 0.0 {
             return None;
         }
-        let h = self.distribution.sample_h(u)?;
+        let (h, _) = self.distribution.sample_visible(wo, uc, u)?;
         if wo.dot(h) <= 0.0 {
             return None;
         }
@@ -141,7 +142,7 @@ impl Bxdf for TorranceSparrow {
         if oh <= 0.0 {
             return 0.0;
         }
-        self.distribution.pdf_h(h) / (4.0 * oh)
+        self.distribution.pdf_visible(wo, h) / (4.0 * oh)
     }
 }
 

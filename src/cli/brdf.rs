@@ -38,7 +38,11 @@ fn parse_wo(s: &str) -> Result<Wo, String> {
     let num = |t: Option<&str>, what: &str| -> Result<Option<f32>, String> {
         match t {
             None => Ok(None),
-            Some(t) => t.trim().parse::<f32>().map(Some).map_err(|_| format!("{what} `{t}` is not a number")),
+            Some(t) => t
+                .trim()
+                .parse::<f32>()
+                .map(Some)
+                .map_err(|_| format!("{what} `{t}` is not a number")),
         }
     };
     let theta = num(it.next(), "THETA_DEG")?.ok_or("expected THETA_DEG[,PHI_DEG]")?;
@@ -47,7 +51,9 @@ fn parse_wo(s: &str) -> Result<Wo, String> {
         return Err("expected THETA_DEG[,PHI_DEG] (at most two numbers)".into());
     }
     if !(0.0..90.0).contains(&theta) {
-        return Err(format!("THETA_DEG = {theta} is out of range: allowed 0 ..< 90"));
+        return Err(format!(
+            "THETA_DEG = {theta} is out of range: allowed 0 ..< 90"
+        ));
     }
     if !phi.is_finite() {
         return Err("PHI_DEG must be finite".into());
@@ -140,21 +146,50 @@ pub fn run(args: &BrdfArgs) -> Result<()> {
             }
         }
     } else if args.albedo {
-        writeln!(out, "# {name}, model {:?}, {} samples per angle, seed {}", bsdf.model(), args.samples, args.seed)?;
-        writeln!(out, "# theta_o  albedo_r albedo_g albedo_b  stderr_r stderr_g stderr_b  samples")?;
+        writeln!(
+            out,
+            "# {name}, model {:?}, {} samples per angle, seed {}",
+            bsdf.model(),
+            args.samples,
+            args.seed
+        )?;
+        writeln!(
+            out,
+            "# theta_o  albedo_r albedo_g albedo_b  stderr_r stderr_g stderr_b  samples"
+        )?;
         let rows: Vec<(u32, Estimate)> = (0..90u32)
             .into_par_iter()
-            .map(|t| (t, albedo_by_sampling(&bsdf, direction_deg(t as f32, args.wo.phi), args.samples, args.seed)))
+            .map(|t| {
+                (
+                    t,
+                    albedo_by_sampling(
+                        &bsdf,
+                        direction_deg(t as f32, args.wo.phi),
+                        args.samples,
+                        args.seed,
+                    ),
+                )
+            })
             .collect();
         for (t, e) in rows {
             writeln!(
                 out,
                 "{t:>3} {:.6} {:.6} {:.6} {:.2e} {:.2e} {:.2e} {}",
-                e.mean[0], e.mean[1], e.mean[2], e.std_error[0], e.std_error[1], e.std_error[2], e.samples
+                e.mean[0],
+                e.mean[1],
+                e.mean[2],
+                e.std_error[0],
+                e.std_error[1],
+                e.std_error[2],
+                e.samples
             )?;
         }
     } else if let Some(path) = &args.plot {
-        let models = [Model::Course, Model::Corrected, model_of(ModelArg::Reference, args.walks.max(256))];
+        let models = [
+            Model::Course,
+            Model::Corrected,
+            model_of(ModelArg::Reference, args.walks.max(256)),
+        ];
         let stacks: Vec<LayeredBsdf> = models.iter().map(|&m| bsdf.with_model(m)).collect();
         plot::plot_stack(name, &stacks, args.samples.min(20_000), args.seed, path)?;
         writeln!(out, "wrote {}", path.display())?;
@@ -168,7 +203,10 @@ fn model_of(m: ModelArg, walks: u32) -> Model {
     match m {
         ModelArg::Course => Model::Course,
         ModelArg::Corrected => Model::Corrected,
-        ModelArg::Reference => Model::Reference(ReferenceParams { samples: walks, ..ReferenceParams::default() }),
+        ModelArg::Reference => Model::Reference(ReferenceParams {
+            samples: walks,
+            ..ReferenceParams::default()
+        }),
     }
 }
 
@@ -184,9 +222,14 @@ fn eval_stdin(bsdf: &LayeredBsdf, wo: Vec3, out: &mut impl Write) -> Result<()> 
             .split_whitespace()
             .map(|x| x.parse::<f32>())
             .collect::<Result<_, _>>()
-            .map_err(|_| anyhow::anyhow!("stdin:{}: expected three numbers `x y z`, got `{t}`", i + 1))?;
+            .map_err(|_| {
+                anyhow::anyhow!("stdin:{}: expected three numbers `x y z`, got `{t}`", i + 1)
+            })?;
         if v.len() != 3 || v.iter().any(|x| !x.is_finite()) {
-            bail!("stdin:{}: expected three finite numbers `x y z`, got `{t}`", i + 1);
+            bail!(
+                "stdin:{}: expected three finite numbers `x y z`, got `{t}`",
+                i + 1
+            );
         }
         let wi = Vec3::new(v[0], v[1], v[2]);
         let len = wi.length();
@@ -200,11 +243,29 @@ fn eval_stdin(bsdf: &LayeredBsdf, wo: Vec3, out: &mut impl Write) -> Result<()> 
     Ok(())
 }
 
-fn summary_one(name: &str, bsdf: &LayeredBsdf, args: &BrdfArgs, out: &mut impl Write) -> Result<()> {
-    writeln!(out, "{name}: {} coat(s), model {:?}, t term {}", bsdf.coats(), bsdf.model(), bsdf.t_term())?;
+fn summary_one(
+    name: &str,
+    bsdf: &LayeredBsdf,
+    args: &BrdfArgs,
+    out: &mut impl Write,
+) -> Result<()> {
+    writeln!(
+        out,
+        "{name}: {} coat(s), model {:?}, t term {}",
+        bsdf.coats(),
+        bsdf.model(),
+        bsdf.t_term()
+    )?;
     for t in [0.0, 30.0, 60.0, 85.0] {
         let e = albedo_by_sampling(bsdf, direction_deg(t, args.wo.phi), args.samples, args.seed);
-        writeln!(out, "  albedo at θo = {t:>2}°: {:.4} {:.4} {:.4} (± {:.1e})", e.mean[0], e.mean[1], e.mean[2], e.std_error.max_channel())?;
+        writeln!(
+            out,
+            "  albedo at θo = {t:>2}°: {:.4} {:.4} {:.4} (± {:.1e})",
+            e.mean[0],
+            e.mean[1],
+            e.mean[2],
+            e.std_error.max_channel()
+        )?;
     }
     Ok(())
 }
@@ -212,11 +273,28 @@ fn summary_one(name: &str, bsdf: &LayeredBsdf, args: &BrdfArgs, out: &mut impl W
 /// The main job on built-in defaults: the catalogue's albedo (luminance) under the three models.
 fn summary(lib: &MaterialLibrary, args: &BrdfArgs, out: &mut impl Write) -> Result<()> {
     let angles = [0.0f32, 45.0, 85.0];
-    let models = [Model::Course, Model::Corrected, model_of(ModelArg::Reference, args.walks)];
+    let models = [
+        Model::Course,
+        Model::Corrected,
+        model_of(ModelArg::Reference, args.walks),
+    ];
     let n = args.samples.min(20_000);
-    writeln!(out, "Directional albedo (Rec.709 luminance) of {} — {n} samples per entry, seed {}", lib.file(), args.seed)?;
-    writeln!(out, "{:<24} {:>25} {:>25} {:>25}", "", "Course", "Corrected", "Reference")?;
-    writeln!(out, "{:<24} {:>25} {:>25} {:>25}", "material  \\  θo =", "0°     45°     85°", "0°     45°     85°", "0°     45°     85°")?;
+    writeln!(
+        out,
+        "Directional albedo (Rec.709 luminance) of {} — {n} samples per entry, seed {}",
+        lib.file(),
+        args.seed
+    )?;
+    writeln!(
+        out,
+        "{:<24} {:>25} {:>25} {:>25}",
+        "", "Course", "Corrected", "Reference"
+    )?;
+    writeln!(
+        out,
+        "{:<24} {:>25} {:>25} {:>25}",
+        "material  \\  θo =", "0°     45°     85°", "0°     45°     85°", "0°     45°     85°"
+    )?;
     let names: Vec<String> = lib.names().map(str::to_owned).collect();
     let rows: Vec<Result<String>> = names
         .par_iter()
@@ -227,7 +305,14 @@ fn summary(lib: &MaterialLibrary, args: &BrdfArgs, out: &mut impl Write) -> Resu
                 let b = base.with_model(m);
                 let cells: Vec<String> = angles
                     .iter()
-                    .map(|&t| format!("{:.3}", albedo_by_sampling(&b, direction_deg(t, 0.0), n, args.seed).mean.luminance()))
+                    .map(|&t| {
+                        format!(
+                            "{:.3}",
+                            albedo_by_sampling(&b, direction_deg(t, 0.0), n, args.seed)
+                                .mean
+                                .luminance()
+                        )
+                    })
                     .collect();
                 row += &format!(" {:>25}", cells.join("   "));
             }
@@ -237,7 +322,13 @@ fn summary(lib: &MaterialLibrary, args: &BrdfArgs, out: &mut impl Write) -> Resu
     for r in rows {
         writeln!(out, "{}", r?)?;
     }
-    writeln!(out, "\nCourse lacks the 1/η² solid-angle compression: glossy bases under a coat gain energy.")?;
-    writeln!(out, "Try: lapidary brdf --material silver_paint --plot silver_paint.png")?;
+    writeln!(
+        out,
+        "\nCourse lacks the 1/η² solid-angle compression: glossy bases under a coat gain energy."
+    )?;
+    writeln!(
+        out,
+        "Try: lapidary brdf --material silver_paint --plot silver_paint.png"
+    )?;
     Ok(())
 }

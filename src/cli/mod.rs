@@ -43,13 +43,29 @@ pub fn run() -> ExitCode {
 /// Writes a file atomically: `write` fills a temporary file beside `path` (same extension, so
 /// encoders that look at it still work), which then replaces `path` by a rename. A failure leaves
 /// an existing `path` untouched.
-pub fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> anyhow::Result<()>) -> anyhow::Result<()> {
-    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    let name = path.file_name().ok_or_else(|| anyhow::anyhow!("{}: not a file path", path.display()))?;
-    let ext = path.extension().map(|e| format!(".{}", e.to_string_lossy())).unwrap_or_default();
-    let tmp: PathBuf = dir.join(format!(".{}.{}.tmp{ext}", name.to_string_lossy(), std::process::id()));
+pub fn write_atomically(
+    path: &Path,
+    write: impl FnOnce(&Path) -> anyhow::Result<()>,
+) -> anyhow::Result<()> {
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let name = path
+        .file_name()
+        .ok_or_else(|| anyhow::anyhow!("{}: not a file path", path.display()))?;
+    let ext = path
+        .extension()
+        .map(|e| format!(".{}", e.to_string_lossy()))
+        .unwrap_or_default();
+    let tmp: PathBuf = dir.join(format!(
+        ".{}.{}.tmp{ext}",
+        name.to_string_lossy(),
+        std::process::id()
+    ));
     let result = write(&tmp).and_then(|()| {
-        std::fs::rename(&tmp, path).map_err(|e| anyhow::anyhow!("{}: cannot replace: {e}", path.display()))
+        std::fs::rename(&tmp, path)
+            .map_err(|e| anyhow::anyhow!("{}: cannot replace: {e}", path.display()))
     });
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);

@@ -23,7 +23,11 @@ pub fn register_font() {
 }
 
 const SLICE_THETAS: [f32; 4] = [0.0, 30.0, 60.0, 80.0];
-const COLOURS: [RGBColor; 3] = [RGBColor(214, 39, 40), RGBColor(31, 119, 180), RGBColor(44, 160, 44)];
+const COLOURS: [RGBColor; 3] = [
+    RGBColor(214, 39, 40),
+    RGBColor(31, 119, 180),
+    RGBColor(44, 160, 44),
+];
 
 fn model_label(m: Model) -> String {
     match m {
@@ -35,7 +39,13 @@ fn model_label(m: Model) -> String {
 
 /// Draws the slices and albedo curves of `stacks` (one per model) to `path` (PNG, written
 /// atomically).
-pub fn plot_stack(name: &str, stacks: &[LayeredBsdf], samples: u64, seed: u64, path: &Path) -> Result<()> {
+pub fn plot_stack(
+    name: &str,
+    stacks: &[LayeredBsdf],
+    samples: u64,
+    seed: u64,
+    path: &Path,
+) -> Result<()> {
     register_font();
     // In-plane slices: wo at azimuth 0, wi over the plane φ ∈ {0, 180°}, signed θi.
     let slices: Vec<Vec<Vec<(f64, f64)>>> = SLICE_THETAS
@@ -78,13 +88,23 @@ pub fn plot_stack(name: &str, stacks: &[LayeredBsdf], samples: u64, seed: u64, p
         let root = BitMapBackend::with_buffer(&mut buf, (W, H)).into_drawing_area();
         let e = |e: DrawingAreaErrorKind<_>| anyhow!("plot: {e:?}");
         root.fill(&WHITE).map_err(e)?;
-        let root = root.titled(&format!("{name}: f·cos θi in the plane of incidence, and directional albedo"), ("sans-serif", 28)).map_err(e)?;
+        let root = root
+            .titled(
+                &format!("{name}: f·cos θi in the plane of incidence, and directional albedo"),
+                ("sans-serif", 28),
+            )
+            .map_err(e)?;
         let (upper, lower) = root.split_vertically(470);
         let panels = upper.split_evenly((1, SLICE_THETAS.len()));
         for ((panel, &to), raw) in panels.iter().zip(SLICE_THETAS.iter()).zip(&slices) {
             // Near-mirror lobes span many decades: switch to a log radius from a tenth of the median.
             let peak = raw.iter().flatten().map(|p| p.1).fold(1e-12, f64::max);
-            let mut positive: Vec<f64> = raw.iter().flatten().map(|p| p.1).filter(|&v| v > 0.0).collect();
+            let mut positive: Vec<f64> = raw
+                .iter()
+                .flatten()
+                .map(|p| p.1)
+                .filter(|&v| v > 0.0)
+                .collect();
             positive.sort_by(f64::total_cmp);
             let median = positive.get(positive.len() / 2).copied().unwrap_or(peak);
             let log = peak > 30.0 * median;
@@ -92,9 +112,18 @@ pub fn plot_stack(name: &str, stacks: &[LayeredBsdf], samples: u64, seed: u64, p
             let radius = |v: f64| if log { (v / floor).max(1.0).log10() } else { v };
             let curves: Vec<Vec<(f64, f64)>> = raw
                 .iter()
-                .map(|c| c.iter().map(|&(s, v)| (radius(v) * s, radius(v) * (1.0 - s * s).max(0.0).sqrt())).collect())
+                .map(|c| {
+                    c.iter()
+                        .map(|&(s, v)| (radius(v) * s, radius(v) * (1.0 - s * s).max(0.0).sqrt()))
+                        .collect()
+                })
                 .collect();
-            let rmax = curves.iter().flatten().map(|&(x, y)| x.hypot(y)).fold(1e-9, f64::max) * 1.05;
+            let rmax = curves
+                .iter()
+                .flatten()
+                .map(|&(x, y)| x.hypot(y))
+                .fold(1e-9, f64::max)
+                * 1.05;
             let caption = if log {
                 format!("θo = {to}°  log10 radius, peak {peak:.3e}")
             } else {
@@ -107,40 +136,79 @@ pub fn plot_stack(name: &str, stacks: &[LayeredBsdf], samples: u64, seed: u64, p
                 .y_label_area_size(48)
                 .build_cartesian_2d(-rmax..rmax, 0.0..rmax)
                 .map_err(e)?;
-            chart.configure_mesh().x_labels(5).y_labels(5).light_line_style(WHITE.mix(0.0)).draw().map_err(e)?;
-            let (s, c) = (f64::from(to.to_radians().sin()), f64::from(to.to_radians().cos()));
             chart
-                .draw_series(LineSeries::new(vec![(0.0, 0.0), (s * rmax, c * rmax)], BLACK.mix(0.35).stroke_width(1)))
+                .configure_mesh()
+                .x_labels(5)
+                .y_labels(5)
+                .light_line_style(WHITE.mix(0.0))
+                .draw()
+                .map_err(e)?;
+            let (s, c) = (
+                f64::from(to.to_radians().sin()),
+                f64::from(to.to_radians().cos()),
+            );
+            chart
+                .draw_series(LineSeries::new(
+                    vec![(0.0, 0.0), (s * rmax, c * rmax)],
+                    BLACK.mix(0.35).stroke_width(1),
+                ))
                 .map_err(e)?;
             for (i, curve) in curves.iter().enumerate().rev() {
                 // Width 1: plotters joins wide polylines with mitres, which shoot off at a spike's 180° turn.
-                chart.draw_series(LineSeries::new(curve.clone(), COLOURS[i % 3].stroke_width(1))).map_err(e)?;
+                chart
+                    .draw_series(LineSeries::new(
+                        curve.clone(),
+                        COLOURS[i % 3].stroke_width(1),
+                    ))
+                    .map_err(e)?;
             }
         }
         let ymax = albedos.iter().flatten().map(|p| p.1).fold(1.05, f64::max) * 1.05;
         let mut chart = ChartBuilder::on(&lower)
-            .caption("directional albedo (luminance) against θo", ("sans-serif", 22))
+            .caption(
+                "directional albedo (luminance) against θo",
+                ("sans-serif", 22),
+            )
             .margin(16)
             .x_label_area_size(40)
             .y_label_area_size(60)
             .build_cartesian_2d(0.0..90.0, 0.0..ymax)
             .map_err(e)?;
-        chart.configure_mesh().x_desc("θo (degrees)").y_desc("albedo").draw().map_err(e)?;
-        chart.draw_series(LineSeries::new(vec![(0.0, 1.0), (90.0, 1.0)], BLACK.mix(0.3))).map_err(e)?;
+        chart
+            .configure_mesh()
+            .x_desc("θo (degrees)")
+            .y_desc("albedo")
+            .draw()
+            .map_err(e)?;
+        chart
+            .draw_series(LineSeries::new(
+                vec![(0.0, 1.0), (90.0, 1.0)],
+                BLACK.mix(0.3),
+            ))
+            .map_err(e)?;
         for (i, (curve, b)) in albedos.iter().zip(stacks).enumerate() {
             let colour = COLOURS[i % 3];
             chart
                 .draw_series(LineSeries::new(curve.clone(), colour.stroke_width(2)))
                 .map_err(e)?
                 .label(model_label(b.model()))
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], colour.stroke_width(3)));
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 24, y)], colour.stroke_width(3))
+                });
         }
-        chart.configure_series_labels().border_style(BLACK).background_style(WHITE.mix(0.9)).position(SeriesLabelPosition::UpperLeft).draw().map_err(e)?;
+        chart
+            .configure_series_labels()
+            .border_style(BLACK)
+            .background_style(WHITE.mix(0.9))
+            .position(SeriesLabelPosition::UpperLeft)
+            .draw()
+            .map_err(e)?;
         root.present().map_err(e)?;
     }
     // plotters draws into the buffer; the `image` crate (PNG only) encodes it.
     let img = image::RgbImage::from_raw(W, H, buf).ok_or_else(|| anyhow!("plot: buffer size"))?;
     super::write_atomically(path, |tmp| {
-        img.save_with_format(tmp, image::ImageFormat::Png).map_err(|e| anyhow!("{}: {e}", path.display()))
+        img.save_with_format(tmp, image::ImageFormat::Png)
+            .map_err(|e| anyhow!("{}: {e}", path.display()))
     })
 }

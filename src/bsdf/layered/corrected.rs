@@ -195,7 +195,7 @@ pub fn sample(
 /// `Q` by stratified Monte Carlo over the Corrected sampling of the layers below, then `ρ̄`, `r_int`
 /// and the multiple lobe's constants.
 pub(super) fn build_tables(stack: &mut LayeredBsdf, l: usize, grid: usize) {
-    let n2 = (grid * grid) as f32;
+    let n2 = (grid * grid * crate::bsdf::table::UC_STRATA) as f32;
     let top = stack.levels[l].top.clone();
     stack.levels[l].e_top = Table::by_sampling(grid, hash_words(&[l as u64, 1]), |wo, uc, u| {
         top.sample(wo, uc, u)
@@ -205,8 +205,7 @@ pub(super) fn build_tables(stack: &mut LayeredBsdf, l: usize, grid: usize) {
 
     let (eta, od) = (stack.levels[l].eta, stack.levels[l].od);
     let this = &*stack;
-    let mut trapped_entries = Vec::new();
-    let albedo_rest = Table::build(|mu| {
+    let (albedo_rest, trapped) = Table::build_pair_par(|mu| {
         let wo_in = Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
         let (mut a, mut q) = (Spectrum::ZERO, Spectrum::ZERO);
         for_strata(
@@ -222,11 +221,8 @@ pub(super) fn build_tables(stack: &mut LayeredBsdf, l: usize, grid: usize) {
                 }
             },
         );
-        trapped_entries.push(q / n2);
-        a / n2
+        (a / n2, q / n2)
     });
-    let mut it = trapped_entries.into_iter();
-    let trapped = Table::build(|_| it.next().unwrap_or(Spectrum::ZERO));
 
     let lv = &stack.levels[l];
     let t_table = Table::build(|mu| Spectrum::splat(lv.t(mu)));

@@ -230,8 +230,9 @@ pub struct LayeredBsdf {
     pub(crate) compensation: bool,
 }
 
-/// MC samples per table entry (a stratified `n × n` grid).
-const TABLE_GRID: usize = 40;
+/// Table entries are measured on a stratified `TABLE_GRID²` grid of directions, each with
+/// `UC_STRATA` lobe choices.
+const TABLE_GRID: usize = 24;
 
 impl LayeredBsdf {
     /// Validates `desc` and builds its runtime tables (a few milliseconds per coat).
