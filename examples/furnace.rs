@@ -8,8 +8,11 @@ use lapidary::bsdf::measure::{albedo_by_sampling, direction_deg};
 use lapidary::bsdf::{Base, Coat, ConductorIor, LayeredBsdf, Model, ReferenceParams, StackDesc};
 use lapidary::color::Spectrum;
 
-/// Albedo rows `(stack, model, [(θo, albedo)])` with `n` samples per angle.
-fn furnace(n: u64) -> Vec<(String, String, Vec<(f32, f32)>)> {
+/// One row: stack name, model name, `(θo, albedo)` pairs.
+type Row = (String, String, Vec<(f32, f32)>);
+
+/// Albedo rows with `n` samples per angle.
+fn furnace(n: u64) -> Vec<Row> {
     let clear = |ior, roughness| Coat {
         ior,
         roughness,

@@ -26,6 +26,8 @@
 
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
+// `!(x > 0.0)` is how this crate rejects NaN together with non-positive values, on purpose.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod bsdf;
 pub mod cli;

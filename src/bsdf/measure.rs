@@ -42,7 +42,7 @@ pub fn direction_deg(theta_deg: f32, phi_deg: f32) -> Vec3 {
 /// Directional albedo `∫ f cos dωi` as the mean `sample` weight over `n` independent samples
 /// (failed samples count as 0). Deterministic for a given `seed`.
 pub fn albedo_by_sampling(b: &impl Bxdf, wo: Vec3, n: u64, seed: u64) -> Estimate {
-    let mut rng = Rng::new(hash_words(&[seed, 0xa1be_d0]));
+    let mut rng = Rng::new(hash_words(&[seed, 0x00a1_bed0]));
     let (mut s1, mut s2) = ([0.0f64; 3], [0.0f64; 3]);
     for _ in 0..n {
         if let Some(s) = b.sample(wo, rng.uniform(), rng.uniform2()) {

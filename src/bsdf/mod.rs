@@ -91,7 +91,7 @@ impl BsdfSample {
     /// finite, so a returned sample is always usable.
     #[inline]
     pub fn from_eval(wi: Vec3, f: Spectrum, pdf: f32, lobe: Lobe) -> Option<Self> {
-        if !(pdf > 0.0 && pdf.is_finite()) || !f.is_valid() {
+        if !(pdf > 0.0 && pdf.is_finite() && f.is_valid()) {
             return None;
         }
         let weight = f * (wi.z.abs() / pdf);

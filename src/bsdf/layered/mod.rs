@@ -376,7 +376,7 @@ pub fn validate(desc: &StackDesc) -> Result<(), StackError> {
             }
         }
         Base::Conductor { ior, roughness } => {
-            if !(roughness >= 0.01 && roughness < 90.0) {
+            if !(0.01..90.0).contains(&roughness) {
                 return bad("base.roughness".into(), roughness, "0.01 ..< 90 degrees");
             }
             if let ConductorIor::Complex { n, k } = ior {
