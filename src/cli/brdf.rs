@@ -148,8 +148,8 @@ pub fn run(args: &BrdfArgs) -> Result<()> {
     } else if args.albedo {
         writeln!(
             out,
-            "# {name}, model {:?}, {} samples per angle, seed {}",
-            bsdf.model(),
+            "# {name}: {}; {} samples per angle, seed {}",
+            bsdf.knobs(),
             args.samples,
             args.seed
         )?;
@@ -249,13 +249,7 @@ fn summary_one(
     args: &BrdfArgs,
     out: &mut impl Write,
 ) -> Result<()> {
-    writeln!(
-        out,
-        "{name}: {} coat(s), model {:?}, t term {}",
-        bsdf.coats(),
-        bsdf.model(),
-        bsdf.t_term()
-    )?;
+    writeln!(out, "{name}: {} coat(s); {}", bsdf.coats(), bsdf.knobs())?;
     for t in [0.0, 30.0, 60.0, 85.0] {
         let e = albedo_by_sampling(bsdf, direction_deg(t, args.wo.phi), args.samples, args.seed);
         writeln!(

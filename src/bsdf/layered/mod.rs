@@ -228,6 +228,8 @@ pub struct LayeredBsdf {
     pub(crate) model: Model,
     pub(crate) t_term: bool,
     pub(crate) compensation: bool,
+    pub(crate) fresnel: FresnelMode,
+    pub(crate) distribution: Distribution,
 }
 
 /// Table entries are measured on a stratified `TABLE_GRID²` grid of directions, each with
@@ -289,6 +291,8 @@ impl LayeredBsdf {
             model: desc.model,
             t_term,
             compensation: desc.compensation,
+            fresnel: desc.fresnel,
+            distribution: desc.distribution,
         };
         for l in (0..stack.levels.len()).rev() {
             corrected::build_tables(&mut stack, l, TABLE_GRID);
@@ -322,6 +326,23 @@ impl LayeredBsdf {
     /// Whether the Course `t` term is applied.
     pub fn t_term(&self) -> bool {
         self.t_term
+    }
+
+    /// Every accuracy knob of this stack in one line, so no approximation is silent:
+    /// model, Fresnel evaluation, distribution, `t` term and compensation.
+    pub fn knobs(&self) -> String {
+        let model = match self.model {
+            Model::Course => "Course".to_string(),
+            Model::Corrected => "Corrected".to_string(),
+            Model::Reference(p) => format!("Reference({} walks, depth {})", p.samples, p.max_depth),
+        };
+        format!(
+            "model {model}, fresnel {:?}, distribution {:?}, t term {}, compensation {}",
+            self.fresnel,
+            self.distribution,
+            if self.t_term { "on" } else { "off" },
+            if self.compensation { "on" } else { "off" }
+        )
     }
 
     /// The same compiled stack evaluated by another model (tables are shared by all models).
