@@ -80,7 +80,7 @@ pub fn run(kind: Distribution, m: f32, n: u64, seed: u64) -> SlopeResult {
         }
     }
     observed[cells] = failed;
-    let mass = GRID.integrate(8, |x, phi| {
+    let mass = GRID.integrate_adaptive(4, 1e-8, 6, |x, phi| {
         let r = x / (1.0 - x);
         let t = alpha * r;
         let cos_t = 1.0 / (1.0 + t * t).sqrt();

@@ -1,11 +1,12 @@
 //! What the chi-square suite tests: the BSDF components with their viewing directions, and the
 //! course catalogue's stacks under the analytic models.
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
+use lapidary::bsdf::dielectric::Lobes;
 use lapidary::bsdf::measure::direction_deg;
 use lapidary::bsdf::{
-    Base, Bsdf, Bxdf, Distribution, Fresnel, FresnelMode, Lambert, LayeredBsdf, Metal,
-    MicrofacetDistribution, Model, OrenNayar, RoughDielectric, TorranceSparrow,
+    Base, Bsdf, BsdfSample, Bxdf, Distribution, Fresnel, FresnelMode, Lambert, LayeredBsdf, Metal,
+    MicrofacetDistribution, Model, OrenNayar, RoughDielectric, TorranceSparrow, TransportMode,
 };
 use lapidary::color::Spectrum;
 use lapidary::recipe::MaterialLibrary;
@@ -203,4 +204,67 @@ pub fn stacks(resolvable: bool) -> Vec<Subject> {
 /// Number of stack configurations.
 pub fn stack_count() -> usize {
     CATALOGUE_SIZE * MODELS.len() * WO_DEG.len()
+}
+
+/// A rough dielectric seen through one transport mode and one lobe selection (the [`Bsdf`] enum
+/// exposes radiance transport with both lobes only).
+pub struct DielectricVariant {
+    /// The interface.
+    pub interface: RoughDielectric,
+    /// Transport mode of `eval` and `sample`.
+    pub mode: TransportMode,
+    /// Lobes `sample` and `pdf` may use.
+    pub lobes: Lobes,
+}
+
+impl Bxdf for DielectricVariant {
+    fn eval(&self, wo: Vec3, wi: Vec3) -> Spectrum {
+        Spectrum::splat(self.interface.eval(wo, wi, self.mode))
+    }
+    fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
+        self.interface.sample(wo, uc, u, self.mode, self.lobes)
+    }
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        self.interface.pdf(wo, wi, self.lobes)
+    }
+}
+
+/// Rough dielectrics in importance transport and with one lobe at a time, on both sides (for the
+/// weight-consistency check only: their pdfs are the ones the chi-square suite tests, restricted
+/// to one lobe).
+pub fn dielectric_variants() -> Vec<Subject> {
+    let mut v: Vec<(String, SharedBxdf, bool)> = Vec::new();
+    for m in [10.0, 30.0] {
+        for (mode, lobes, label) in [
+            (
+                TransportMode::Importance,
+                Lobes::All,
+                "importance, both lobes",
+            ),
+            (
+                TransportMode::Radiance,
+                Lobes::Reflection,
+                "radiance, reflection",
+            ),
+            (
+                TransportMode::Radiance,
+                Lobes::Transmission,
+                "radiance, transmission",
+            ),
+        ] {
+            v.push((
+                format!("rough dielectric m={m} {label}"),
+                Arc::new(DielectricVariant {
+                    interface: RoughDielectric::new(
+                        MicrofacetDistribution::new(Distribution::Blinn, m),
+                        1.5,
+                    ),
+                    mode,
+                    lobes,
+                }),
+                true,
+            ));
+        }
+    }
+    expand(v)
 }

@@ -7,7 +7,8 @@
 //! - [`chi_square_pooled`]: Pearson's statistic over histogram cells with low-expectation cells
 //!   pooled and samples in zero-expectation cells reported.
 //! - [`Grid2`], [`SphereGrid`]: 2-D histograms (generic rectangle; the full sphere of directions in
-//!   `(θ, φ)`) with a per-bin integrator of a density (composite Gauss–Legendre).
+//!   `(θ, φ)`) with a per-bin integrator of a density (composite 3 × 3 Gauss–Legendre, refined
+//!   adaptively where the density has narrow peaks or edges).
 //! - [`par_map`]: runs independent configurations on all cores, results in input order.
 //!
 //! Every helper here is deterministic; nothing draws random numbers.
@@ -271,30 +272,87 @@ impl Grid2 {
     /// `∫∫_bin density(u, v) du dv` for every bin: each bin is split into `sub × sub` cells with
     /// 3 × 3 Gauss–Legendre points each (a composite rule, A&S 25.4.29 per cell).
     pub fn integrate(&self, sub: usize, density: impl Fn(f64, f64) -> f64) -> Vec<f64> {
+        self.integrate_adaptive(sub, 0.0, 0, density)
+    }
+
+    /// Like [`Self::integrate`], but every cell is refined adaptively: a cell's 3 × 3-point
+    /// estimate is compared with the sum of the estimates of its four quarters; if they differ by
+    /// more than `tol` (and `max_depth` allows), each quarter is refined in turn with `tol / 2`,
+    /// otherwise the quarters' sum is kept. So every bin gets at least `2sub × 2sub` cells, and
+    /// narrow peaks and discontinuities (a glossy lobe squeezed at grazing angles, a horizon)
+    /// get as many more as they need. With `max_depth == 0` this is the plain composite rule.
+    pub fn integrate_adaptive(
+        &self,
+        sub: usize,
+        tol: f64,
+        max_depth: u32,
+        density: impl Fn(f64, f64) -> f64,
+    ) -> Vec<f64> {
         let (du, dv) = (
             (self.u.1 - self.u.0) / (self.nu * sub) as f64,
             (self.v.1 - self.v.0) / (self.nv * sub) as f64,
         );
+        let f = &density;
         let mut out = vec![0.0; self.len()];
         for i in 0..self.nu {
             for j in 0..self.nv {
                 let mut sum = 0.0;
                 for a in 0..sub {
-                    let uc = self.u.0 + ((i * sub + a) as f64 + 0.5) * du;
+                    let u0 = self.u.0 + (i * sub + a) as f64 * du;
                     for b in 0..sub {
-                        let vc = self.v.0 + ((j * sub + b) as f64 + 0.5) * dv;
-                        for &(xu, wu) in &GL3 {
-                            for &(xv, wv) in &GL3 {
-                                sum += wu * wv * density(uc + 0.5 * du * xu, vc + 0.5 * dv * xv);
-                            }
-                        }
+                        let v0 = self.v.0 + (j * sub + b) as f64 * dv;
+                        let coarse = gl_cell(u0, v0, du, dv, f);
+                        sum += if max_depth == 0 {
+                            coarse
+                        } else {
+                            refine(u0, v0, du, dv, coarse, tol, max_depth, f)
+                        };
                     }
                 }
-                out[i * self.nv + j] = sum * 0.25 * du * dv;
+                out[i * self.nv + j] = sum;
             }
         }
         out
     }
+}
+
+/// 3 × 3-point Gauss–Legendre estimate of `∫∫ f` over the cell `[u0, u0+du] × [v0, v0+dv]`.
+fn gl_cell(u0: f64, v0: f64, du: f64, dv: f64, f: &impl Fn(f64, f64) -> f64) -> f64 {
+    let (uc, vc) = (u0 + 0.5 * du, v0 + 0.5 * dv);
+    let mut sum = 0.0;
+    for &(xu, wu) in &GL3 {
+        for &(xv, wv) in &GL3 {
+            sum += wu * wv * f(uc + 0.5 * du * xu, vc + 0.5 * dv * xv);
+        }
+    }
+    sum * 0.25 * du * dv
+}
+
+/// One step of the adaptive rule of [`Grid2::integrate_adaptive`]; `coarse` is the cell's own
+/// estimate.
+#[allow(clippy::too_many_arguments)]
+fn refine(
+    u0: f64,
+    v0: f64,
+    du: f64,
+    dv: f64,
+    coarse: f64,
+    tol: f64,
+    depth: u32,
+    f: &impl Fn(f64, f64) -> f64,
+) -> f64 {
+    let (hu, hv) = (0.5 * du, 0.5 * dv);
+    let corners = [(u0, v0), (u0 + hu, v0), (u0, v0 + hv), (u0 + hu, v0 + hv)];
+    let quarters = corners.map(|(a, b)| gl_cell(a, b, hu, hv, f));
+    let fine: f64 = quarters.iter().sum();
+    if depth <= 1 || (fine - coarse).abs() <= tol {
+        return fine;
+    }
+    corners
+        .iter()
+        .zip(quarters)
+        .map(|(&(a, b), q)| refine(a, b, hu, hv, q, 0.5 * tol, depth - 1, f))
+        .sum()
 }
 
 /// A histogram over the **full** sphere of directions: `θ ∈ [0, π]` from `+z` in `n_theta`
@@ -350,15 +408,23 @@ impl SphereGrid {
         self.grid.bin(t, p)
     }
 
-    /// `∫_bin pdf(ω) dω` for every bin (`dω = sin θ dθ dφ`), with `sub × sub` cells of 3 × 3
-    /// Gauss–Legendre points per bin. `pdf` receives unit `f32` directions.
-    pub fn integrate(&self, sub: usize, pdf: impl Fn(Vec3) -> f64) -> Vec<f64> {
-        self.grid.integrate(sub, |theta, phi| {
-            let (st, ct) = theta.sin_cos();
-            let (sp, cp) = phi.sin_cos();
-            let w = Vec3::new((st * cp) as f32, (st * sp) as f32, ct as f32);
-            pdf(w) * st
-        })
+    /// `∫_bin pdf(ω) dω` for every bin (`dω = sin θ dθ dφ`) by [`Grid2::integrate_adaptive`]
+    /// (`sub × sub` cells per bin, each refined to absolute tolerance `tol`, at most `max_depth`
+    /// halvings). `pdf` receives unit `f32` directions.
+    pub fn integrate(
+        &self,
+        sub: usize,
+        tol: f64,
+        max_depth: u32,
+        pdf: impl Fn(Vec3) -> f64,
+    ) -> Vec<f64> {
+        self.grid
+            .integrate_adaptive(sub, tol, max_depth, |theta, phi| {
+                let (st, ct) = theta.sin_cos();
+                let (sp, cp) = phi.sin_cos();
+                let w = Vec3::new((st * cp) as f32, (st * sp) as f32, ct as f32);
+                pdf(w) * st
+            })
     }
 }
 

@@ -18,7 +18,7 @@
 use super::{LayeredBsdf, absorption, course};
 use crate::bsdf::table::{Table, for_strata};
 use crate::bsdf::{
-    BsdfSample, Bxdf, Lobe, LobeKind, microfacet::v_cavity_g, refract_macro,
+    Bsdf, BsdfSample, Bxdf, Lobe, LobeKind, microfacet::v_cavity_g, refract_macro,
     sample_cosine_hemisphere,
 };
 use crate::color::Spectrum;
@@ -101,6 +101,39 @@ fn lobe_weights(
     }
 }
 
+/// When the layer below level `l` is a diffuse base (Lambert or Oren–Nayar, sampled by cosine),
+/// the rest lobe samples only the **escape cone** `sin θ' < 1/η` — the inner directions that can
+/// leave — instead of the whole hemisphere, so no sample is spent on a direction that must fail.
+/// Returns the cone's squared disk radius `1/η²`, or `None` (glossy base, deeper coat, `η ≤ 1`).
+/// The tables still integrate the base over the whole hemisphere.
+#[inline]
+fn escape_cone(stack: &LayeredBsdf, l: usize) -> Option<f32> {
+    let eta = stack.levels[l].eta;
+    let diffuse = matches!(stack.base, Bsdf::Lambert(_) | Bsdf::OrenNayar(_));
+    (l + 1 == stack.levels.len() && diffuse && eta > 1.0).then(|| 1.0 / (eta * eta))
+}
+
+/// Cosine-weighted sampling restricted to the cone `sin²θ < r2`: Malley's method on the disk of
+/// radius `√r2`. Density `cos θ / (π r2)` inside the cone.
+#[inline]
+fn sample_cone_cosine(u: Vec2, r2: f32) -> Option<Vec3> {
+    let d = sample_cosine_hemisphere(u)?;
+    let r = r2.sqrt();
+    let (x, y) = (d.x * r, d.y * r);
+    let z = (1.0 - x * x - y * y).max(0.0).sqrt();
+    (z > 0.0).then(|| Vec3::new(x, y, z))
+}
+
+/// Density of [`sample_cone_cosine`].
+#[inline]
+fn cone_cosine_pdf(w: Vec3, r2: f32) -> f32 {
+    if w.z <= 0.0 || crate::bsdf::sin2_theta(w) >= r2 {
+        0.0
+    } else {
+        w.z * FRAC_1_PI / r2
+    }
+}
+
 /// Density of the shared mixture at level `l`.
 pub fn pdf(stack: &LayeredBsdf, l: usize, wo: Vec3, wi: Vec3, corrected: bool) -> f32 {
     let Some(lv) = stack.levels.get(l) else {
@@ -118,7 +151,11 @@ pub fn pdf(stack: &LayeredBsdf, l: usize, wo: Vec3, wi: Vec3, corrected: bool) -
         && let (Some(wo_in), Some(wi_in)) = (wo_in, refract_macro(wi, lv.eta))
     {
         let jacobian = wi.z / (lv.eta * lv.eta * wi_in.z);
-        p += w[1] * pdf(stack, l + 1, wo_in, wi_in, corrected) * jacobian;
+        let rest = match escape_cone(stack, l) {
+            Some(r2) => cone_cosine_pdf(wi_in, r2),
+            None => pdf(stack, l + 1, wo_in, wi_in, corrected),
+        };
+        p += w[1] * rest * jacobian;
     }
     p += w[2] * wi.z * FRAC_1_PI;
     if p.is_finite() { p } else { 0.0 }
@@ -163,7 +200,19 @@ fn sample_dir(
     }
     if uc < w[0] + w[1] || w[2] == 0.0 {
         let uc2 = ((uc - w[0]) / w[1]).clamp(0.0, 1.0);
-        let (wi_in, lobe) = sample_dir(stack, l + 1, wo_in?, uc2, u, corrected)?;
+        let (wi_in, lobe) = match escape_cone(stack, l) {
+            Some(r2) => {
+                let kind = LobeKind::Diffuse;
+                (
+                    sample_cone_cosine(u, r2)?,
+                    Lobe {
+                        kind,
+                        layer: (l + 1) as u8,
+                    },
+                )
+            }
+            None => sample_dir(stack, l + 1, wo_in?, uc2, u, corrected)?,
+        };
         let wi = refract_macro(wi_in, 1.0 / lv.eta)?;
         return Some((wi, lobe));
     }
