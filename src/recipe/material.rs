@@ -5,7 +5,7 @@
 //! (
 //!     coats: [(ior: 1.6, roughness: 12.0, thickness: 0.5)],
 //!     base: Lambert(albedo: Srgb(0.37, 0.09, 0.11)),
-//!     // optional: model: Corrected | Course | Reference(samples: 4, max_depth: 32),
+//!     // optional: model: Corrected | Course | Reference(samples: 4, max_depth: 256),
 //!     //           fresnel: Exact | Schlick | Lazanyi | Table, distribution: Blinn | Beckmann,
 //!     //           t_term: true/false, compensation: true/false
 //! )
@@ -108,7 +108,7 @@ pub enum ModelDesc {
         /// Walks per evaluation (default 4).
         #[serde(default = "default_samples")]
         samples: u32,
-        /// Maximum bounces per walk (default 32).
+        /// Maximum bounces per walk (default 256).
         #[serde(default = "default_depth")]
         max_depth: u32,
     },

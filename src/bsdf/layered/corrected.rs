@@ -1,16 +1,22 @@
 //! The Corrected model (the default) and the sampling mixture shared with the Course model.
 //!
 //! `f = f_top + T(wi)·T(wo)/η² · a · f_rest(wo', wi') + f_multi(wo, wi)` with `T(w) = 1 − E_top(w)`
-//! (the albedo coupling of Kelemen & Szirmay-Kalos, course ref. [20]) and
-//! `f_multi = q(wo) · ρ̄/(1 − ρ̄ r_int) · T(wi)/(π η²)`, `q(wo) = T(wo) · Q(cos θo')`, where
+//! (the albedo coupling of Kelemen & Szirmay-Kalos, course ref. [20]) and the multiple-reflection
+//! lobe `f_multi = M · q(wo) q(wi) / N`, `q(w) = T(w) · Q(cos θ')`, `M = ρ̄(1 − r_int)/(1 − ρ̄ r_int)`,
+//! `N = ∫ q cos θ dω`, where
 //! `Q(μ') = ∫ (1 − T_out(wi')) a f_rest cos θi' dωi'` is the energy the layers below send back up
 //! that the interface returns (internal Fresnel reflection and total internal reflection), `ρ̄` the
 //! cosine-weighted albedo of the layers below with absorption and `r_int = 1 − ∫ T cos/(πη²) dω` the
 //! coat's internal diffuse reflectance. With a white Lambert base and no absorption this gives
 //! albedo exactly `E_top + T = 1` (up to the tables' quadrature error).
 //!
-//! `f_multi` is not exactly reciprocal (`q(wo)` and `T(wi)` differ in shape); the reciprocity test
-//! reports by how much. Sampling picks one of three lobes with weights that depend on `wo` only —
+//! DESIGN §3.2 writes the lobe as `q(wo) · ρ̄/(1 − ρ̄ r_int) · T(wi)/(π η²)`: trapped energy that
+//! leaves with the distribution of diffuse inner light. Its albedo is `M q(wo)`, but it is not
+//! reciprocal when `Q` varies with the angle (glossy bases). The form used here has the same
+//! albedo `M q(wo)` for every `wo` (so the furnace property is unchanged), is symmetric in `wo`,
+//! `wi`, and equals the DESIGN form exactly when `Q` is constant (diffuse bases): the light that
+//! leaves toward `wi` after inner bounces is distributed like the light from `wi` that gets
+//! trapped, as reciprocity requires. Sampling picks one of three lobes with weights that depend on `wo` only —
 //! the top lobe's albedo, the single-scatter albedo `T(wo)·(A − Q)` and the multiple lobe's albedo —
 //! so `pdf = Σ w_k p_k` (course eq. 3.6) is exact; the lower lobe's pdf carries the refraction
 //! Jacobian `cos θi / (η² cos θi')`.
@@ -42,7 +48,7 @@ pub fn eval(stack: &LayeredBsdf, l: usize, wo: Vec3, wi: Vec3) -> Spectrum {
     if let Some(wi_in) = refract_macro(wi, lv.eta) {
         let rest = eval(stack, l + 1, wo_in, wi_in);
         if !rest.is_black() {
-            let exit = if stack.t_term {
+            let exit = if stack.t_term() {
                 let h = (wo + wi).normalize_or_zero();
                 let g = if h.z > 0.0 {
                     v_cavity_g(wo, wi, h)
@@ -56,7 +62,9 @@ pub fn eval(stack: &LayeredBsdf, l: usize, wo: Vec3, wi: Vec3) -> Spectrum {
             f += rest * absorption(lv.od, wo_in.z, wi_in.z) * (ti * exit / (lv.eta * lv.eta));
         }
     }
-    f + lv.trapped.at(wo_in.z) * lv.multi_scale * (to * ti)
+    // Symmetric multiple-reflection lobe M · q(wo) q(wi) / ∫q cos (module docs).
+    let qi = refract_macro(wi, lv.eta).map_or(Spectrum::ZERO, |w| lv.trapped.at(w.z) * ti);
+    f + lv.trapped.at(wo_in.z) * qi * lv.multi_scale * to
 }
 
 /// Evaluates level `l` under the analytic model selected by `corrected`.
@@ -280,8 +288,19 @@ pub(super) fn build_tables(stack: &mut LayeredBsdf, l: usize, grid: usize) {
         .hemispherical(|_| 1.0)
         .map(|x| x.clamp(0.0, 1.0));
     let denom = (Spectrum::ONE - rho_bar * r_int).map(|d| d.max(1e-6));
-    let multi_scale = rho_bar.zip(denom, |r, d| r / d / (PI * eta * eta));
     let multi_albedo = rho_bar.zip(denom, |r, d| r * (1.0 - r_int) / d);
+    // N = ∫ q(w) cos θ dω = 2π ∫₀¹ T(μ) Q(μ'(μ)) μ dμ, by the midpoint rule.
+    let steps = 2048;
+    let mut q_norm = Spectrum::ZERO;
+    for i in 0..steps {
+        let mu = (i as f32 + 0.5) / steps as f32;
+        let mu_in = (1.0 - (1.0 - mu * mu) / (eta * eta)).max(0.0).sqrt();
+        if mu_in > 0.0 && (1.0 - mu * mu) < eta * eta {
+            q_norm += trapped.at(mu_in) * (lv.t(mu) * mu);
+        }
+    }
+    q_norm = q_norm * (2.0 * PI / steps as f32);
+    let multi_scale = multi_albedo.zip(q_norm, |m, n| if n > 1e-12 { m / n } else { 0.0 });
     let lv = &mut stack.levels[l];
     lv.albedo_rest = albedo_rest;
     lv.trapped = trapped;

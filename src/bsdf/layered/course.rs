@@ -28,7 +28,7 @@ pub fn eval(stack: &LayeredBsdf, l: usize, wo: Vec3, wi: Vec3) -> Spectrum {
         return f;
     }
     let t12 = 1.0 - lv.fresnel.eval(wi.z)[0];
-    let t = if stack.t_term {
+    let t = if stack.t_term() {
         let h = (wo + wi).normalize_or_zero();
         let g = if h.z > 0.0 {
             v_cavity_g(wo, wi, h)

@@ -86,7 +86,10 @@ pub enum Base {
 pub struct ReferenceParams {
     /// Independent walks averaged by one `eval` (≥ 1).
     pub samples: u32,
-    /// Maximum number of bounces at the base per walk (Russian roulette usually ends walks earlier).
+    /// Maximum number of bounces at the base per walk. Russian roulette ends ordinary walks after a
+    /// few bounces; the limit matters for near-mirror bases under a coat, where light trapped by
+    /// total internal reflection keeps its weight (32 lost 6% at θo 80° for m 0.5°; 256 loses
+    /// none measurable).
     pub max_depth: u32,
 }
 
@@ -94,7 +97,7 @@ impl Default for ReferenceParams {
     fn default() -> Self {
         ReferenceParams {
             samples: 4,
-            max_depth: 32,
+            max_depth: 256,
         }
     }
 }
@@ -188,7 +191,7 @@ pub(crate) struct Level {
     pub albedo_rest: Table,
     /// `Q(μ') = ∫ (1 − T_out(wi')) a f_rest cos θi' dωi'`: what the interface sends back down.
     pub trapped: Table,
-    /// `ρ̄ / (1 − ρ̄ r_int) / (π η²)`: the multiple-reflection lobe's scale.
+    /// `M / N`: the multiple-reflection lobe's scale (see [`corrected`]).
     pub multi_scale: Spectrum,
     /// Fraction of `q` that leaves after the inner bounces: `ρ̄ (1 − r_int) / (1 − ρ̄ r_int)`.
     pub multi_albedo: Spectrum,
@@ -226,7 +229,8 @@ pub struct LayeredBsdf {
     /// The base as the course defines it (never compensated), used by Course.
     pub(crate) base_plain: Bsdf,
     pub(crate) model: Model,
-    pub(crate) t_term: bool,
+    /// The recipe's explicit `t_term`, if any (the default depends on the current model).
+    pub(crate) t_term: Option<bool>,
     pub(crate) compensation: bool,
     pub(crate) fresnel: FresnelMode,
     pub(crate) distribution: Distribution,
@@ -283,7 +287,7 @@ impl LayeredBsdf {
             }
             b => b,
         };
-        let t_term = desc.t_term.unwrap_or(matches!(desc.model, Model::Course));
+        let t_term = desc.t_term;
         let mut stack = LayeredBsdf {
             levels: levels.into_boxed_slice(),
             base,
@@ -325,7 +329,7 @@ impl LayeredBsdf {
 
     /// Whether the Course `t` term is applied.
     pub fn t_term(&self) -> bool {
-        self.t_term
+        self.t_term.unwrap_or(matches!(self.model, Model::Course))
     }
 
     /// Every accuracy knob of this stack in one line, so no approximation is silent:
@@ -340,7 +344,7 @@ impl LayeredBsdf {
             "model {model}, fresnel {:?}, distribution {:?}, t term {}, compensation {}",
             self.fresnel,
             self.distribution,
-            if self.t_term { "on" } else { "off" },
+            if self.t_term() { "on" } else { "off" },
             if self.compensation { "on" } else { "off" }
         )
     }
