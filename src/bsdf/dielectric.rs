@@ -132,7 +132,7 @@ impl RoughDielectric {
         if h.z < 0.0 {
             h = -h;
         }
-        if h.dot(wi) * ci < 0.0 || h.dot(wo) * co < 0.0 {
+        if h.dot(wi) * ci <= 0.0 || h.dot(wo) * co <= 0.0 {
             return None;
         }
         Some((h, reflect, etap))

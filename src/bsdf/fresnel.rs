@@ -48,13 +48,25 @@ pub fn conductor(cos_i: f32, n: f32, k: f32) -> f32 {
     let a = (0.5 * (m + er)).max(0.0).sqrt(); // Re sqrt(η² − sin²θ)
     let b = (0.5 * (m - er)).max(0.0).sqrt(); // Im sqrt(η² − sin²θ)
     // r⊥ = (cosθ − (a+ib)) / (cosθ + (a+ib))
-    let rs = ((c - a).powi(2) + b * b) / ((c + a).powi(2) + b * b);
+    // At grazing incidence with a real, index-matched medium both denominators vanish; the limit
+    // of either ratio is 1 there, as for every interface at grazing.
+    let den_s = (c + a).powi(2) + b * b;
+    let rs = if den_s > 0.0 {
+        ((c - a).powi(2) + b * b) / den_s
+    } else {
+        1.0
+    };
     // r∥ = (η² cosθ − (a+ib)) / (η² cosθ + (a+ib)), with η² = (n²−k²) + i 2nk
     let (pr, pi) = ((n * n - k * k) * c, 2.0 * n * k * c);
     let num = (pr - a).powi(2) + (pi - b).powi(2);
     let den = (pr + a).powi(2) + (pi + b).powi(2);
     let rp = if den > 0.0 { num / den } else { 1.0 };
-    (0.5 * (rs + rp)).clamp(0.0, 1.0) as f32
+    let f = 0.5 * (rs + rp);
+    if f.is_finite() {
+        f.clamp(0.0, 1.0) as f32
+    } else {
+        1.0
+    }
 }
 
 /// Schlick's approximation `R0 + (1 − R0)(1 − cos)^5` (Schlick 1994, "An inexpensive BRDF model for
@@ -372,6 +384,10 @@ mod tests {
             }
             assert!((conductor(0.0, n, k) - 1.0).abs() < 1e-6);
         }
+        // Index-matched and real (n = 1, k = 0): finite everywhere, 1 at grazing.
+        assert_eq!(conductor(0.0, 1.0, 0.0), 1.0);
+        assert_eq!(conductor(-0.0, 1.0, 0.0), 1.0);
+        assert!(conductor(0.5, 1.0, 0.0).abs() < 1e-7);
     }
 
     #[test]

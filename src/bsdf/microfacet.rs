@@ -151,7 +151,9 @@ impl MicrofacetDistribution {
         if w.z <= 0.0 || wh <= 0.0 {
             return 0.0;
         }
-        let p = v_cavity_g1(w, h) * wh * self.d(h) / w.z;
+        // (wh / w.z) first: with D deep in the subnormal range a product with a small cosine
+        // would underflow to 0 while f (divided by cosines) is still positive.
+        let p = v_cavity_g1(w, h) * self.d(h) * (wh / w.z);
         if p.is_finite() { p } else { 0.0 }
     }
 }

@@ -92,6 +92,11 @@ impl Bxdf for TorranceSparrow {
         let Some(h) = Self::half(wo, wi) else {
             return Spectrum::ZERO;
         };
+        // Near grazing mirror pairs, rounding can tilt h past a direction: a back-facing facet
+        // scatters nothing (and `pdf` is 0 there too).
+        if wo.dot(h) <= 0.0 || wi.dot(h) <= 0.0 {
+            return Spectrum::ZERO;
+        }
         let d = self.distribution.d(h);
         if d == 0.0 {
             return Spectrum::ZERO;

@@ -77,6 +77,9 @@ fn eval_model(stack: &LayeredBsdf, l: usize, wo: Vec3, wi: Vec3, corrected: bool
     }
 }
 
+/// Smallest selection weight of a lobe that can contribute.
+const LOBE_FLOOR: f32 = 1e-5;
+
 /// Lobe-selection weights `[top, rest, multiple]` at level `l` for `wo` (sum 1, or all 0 when the
 /// level reflects nothing), and the refracted `wo'`.
 #[inline]
@@ -99,6 +102,15 @@ fn lobe_weights(
             w[2] = t * (q * lv.multi_albedo).luminance().max(0.0);
         } else {
             w[1] = t * a.luminance().max(0.0);
+        }
+    }
+    // Floors keep every lobe that can be non-zero sampleable (pdf > 0 wherever f > 0), also where
+    // a table rounds a tiny albedo to 0 (e.g. m → 90°, where D·cos sampling almost always fails).
+    w[0] = w[0].max(LOBE_FLOOR);
+    if wo_in.is_some() {
+        w[1] = w[1].max(LOBE_FLOOR);
+        if corrected {
+            w[2] = w[2].max(LOBE_FLOOR);
         }
     }
     let sum = w[0] + w[1] + w[2];
@@ -132,10 +144,10 @@ fn sample_cone_cosine(u: Vec2, r2: f32) -> Option<Vec3> {
     (z > 0.0).then(|| Vec3::new(x, y, z))
 }
 
-/// Density of [`sample_cone_cosine`].
+/// Density of [`sample_cone_cosine`] for a direction known to lie in the cone.
 #[inline]
 fn cone_cosine_pdf(w: Vec3, r2: f32) -> f32 {
-    if w.z <= 0.0 || crate::bsdf::sin2_theta(w) >= r2 {
+    if w.z <= 0.0 {
         0.0
     } else {
         w.z * FRAC_1_PI / r2
@@ -160,6 +172,8 @@ pub fn pdf(stack: &LayeredBsdf, l: usize, wo: Vec3, wi: Vec3, corrected: bool) -
     {
         let jacobian = wi.z / (lv.eta * lv.eta * wi_in.z);
         let rest = match escape_cone(stack, l) {
+            // wi_in came from refracting an outside direction, so it lies in the cone by
+            // construction; testing sin²θ against 1/η² again could fail by rounding at grazing.
             Some(r2) => cone_cosine_pdf(wi_in, r2),
             None => pdf(stack, l + 1, wo_in, wi_in, corrected),
         };
