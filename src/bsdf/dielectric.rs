@@ -159,7 +159,11 @@ impl RoughDielectric {
             }
             ft
         };
-        if v.is_finite() { v.max(0.0) } else { 0.0 }
+        if v.is_finite() && v >= super::F_FLUSH {
+            v
+        } else {
+            0.0
+        }
     }
 
     /// Density of sampling `wi` from `wo` with the given lobes allowed.

@@ -178,6 +178,17 @@ impl From<LayeredBsdf> for Bsdf {
     }
 }
 
+/// Values of `f` below this (sr⁻¹) are flushed to exactly 0: they carry no energy, and products
+/// deep in the subnormal range (D ≈ 1e-42 times a Fresnel factor) can underflow differently in
+/// `eval` and `pdf`, which would break "pdf > 0 wherever f > 0".
+pub const F_FLUSH: f32 = 1e-30;
+
+/// Flushes channels below [`F_FLUSH`] to 0.
+#[inline]
+pub fn flush_tiny(f: Spectrum) -> Spectrum {
+    f.map(|v| if v < F_FLUSH { 0.0 } else { v })
+}
+
 /// `cos θ` of a local direction.
 #[inline]
 pub fn cos_theta(w: Vec3) -> f32 {

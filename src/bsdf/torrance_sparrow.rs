@@ -12,7 +12,7 @@
 //! albedo 1 at every angle. It depends on `wo` only, so it is not reciprocal.
 
 use super::table::Table;
-use super::{Bsdf, Lobe, LobeKind};
+use super::{Bsdf, Lobe, LobeKind, flush_tiny};
 use super::{BsdfSample, Bxdf, Fresnel, MicrofacetDistribution, microfacet::v_cavity_g, reflect};
 use crate::color::Spectrum;
 use crate::sampler::hash_words;
@@ -104,11 +104,11 @@ impl Bxdf for TorranceSparrow {
         let g = v_cavity_g(wo, wi, h);
         let f = self.fresnel.eval(wi.dot(h).max(0.0));
         let v = f * (d * g / (4.0 * wo.z * wi.z));
-        if self.compensation.is_some() {
+        flush_tiny(if self.compensation.is_some() {
             v * self.compensation_factor(wo)
         } else {
             v
-        }
+        })
     }
 
     #[inline]

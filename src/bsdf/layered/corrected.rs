@@ -258,7 +258,7 @@ pub fn sample(
     corrected: bool,
 ) -> Option<BsdfSample> {
     let (wi, lobe) = sample_dir(stack, l, wo, uc, u, corrected)?;
-    let f = eval_model(stack, l, wo, wi, corrected);
+    let f = crate::bsdf::flush_tiny(eval_model(stack, l, wo, wi, corrected));
     BsdfSample::from_eval(wi, f, pdf(stack, l, wo, wi, corrected), lobe)
 }
 

@@ -427,11 +427,11 @@ pub fn validate(desc: &StackDesc) -> Result<(), StackError> {
 impl Bxdf for LayeredBsdf {
     #[inline]
     fn eval(&self, wo: Vec3, wi: Vec3) -> Spectrum {
-        match self.model {
+        super::flush_tiny(match self.model {
             Model::Course => course::eval(self, 0, wo, wi),
             Model::Corrected => corrected::eval(self, 0, wo, wi),
             Model::Reference(p) => reference::eval(self, p, wo, wi),
-        }
+        })
     }
     #[inline]
     fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
