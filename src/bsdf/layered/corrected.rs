@@ -313,7 +313,7 @@ pub(super) fn build_tables(stack: &mut LayeredBsdf, l: usize, grid: usize) {
             q_norm += trapped.at(mu_in) * (lv.t(mu) * mu);
         }
     }
-    q_norm = q_norm * (2.0 * PI / steps as f32);
+    q_norm *= 2.0 * PI / steps as f32;
     let multi_scale = multi_albedo.zip(q_norm, |m, n| if n > 1e-12 { m / n } else { 0.0 });
     let lv = &mut stack.levels[l];
     lv.albedo_rest = albedo_rest;
