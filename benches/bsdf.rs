@@ -8,10 +8,16 @@
 //! unpredictable as they are in a renderer and the per-call time is the iteration time / `BATCH`
 //! (criterion's throughput line reports it as elements per second).
 //!
+//! Per-call times are the benchmark thread's CPU time on 64-bit Linux (`CLOCK_THREAD_CPUTIME_ID`),
+//! so that builds and tests running at the same time on a small machine do not inflate them by
+//! preempting the benchmark (on a quiet machine it equals wall time); table builds, which run in
+//! parallel, are timed by the wall clock and by the process's CPU time. Elsewhere everything is wall
+//! time.
+//!
 //! Run with `cargo bench --bench bsdf` (release profile, about five minutes on two cores); a filter
 //! narrows it, e.g. `cargo bench --bench bsdf -- ratio`. No number here is asserted anywhere.
 
-use criterion::{BenchmarkGroup, Criterion, SamplingMode, Throughput, measurement::WallTime};
+use criterion::{BenchmarkGroup, Criterion, SamplingMode, Throughput};
 use glam::{Vec2, Vec3};
 use lapidary::bsdf::dielectric::Lobes;
 use lapidary::bsdf::{
@@ -24,6 +30,128 @@ use lapidary::recipe::MaterialLibrary;
 use lapidary::sampler::Rng;
 use std::hint::black_box;
 use std::time::Duration;
+
+/// Clocks for criterion (see the file's docs): on 64-bit Linux a measurement that reads, through
+/// `clock_gettime`, the clock selected with [`clock::select`]; elsewhere criterion's wall time.
+mod clock {
+    /// Which time a benchmark measures.
+    #[derive(Clone, Copy)]
+    pub enum Kind {
+        /// CPU time of the benchmark thread (per-call benchmarks).
+        Thread,
+        /// CPU time of all threads of the process (parallel table builds: total work).
+        Process,
+        /// Wall time (parallel table builds: latency).
+        Wall,
+    }
+
+    #[cfg(all(target_os = "linux", target_pointer_width = "64"))]
+    pub use linux::{CPU_CLOCKS, Clock, select};
+
+    /// The measurement criterion is configured with.
+    pub fn measurement() -> Clock {
+        #[cfg(all(target_os = "linux", target_pointer_width = "64"))]
+        return Clock;
+        #[cfg(not(all(target_os = "linux", target_pointer_width = "64")))]
+        return criterion::measurement::WallTime;
+    }
+
+    #[cfg(all(target_os = "linux", target_pointer_width = "64"))]
+    mod linux {
+        use super::Kind;
+        use criterion::measurement::{Measurement, ValueFormatter, WallTime};
+        use std::ffi::{c_int, c_long};
+        use std::sync::atomic::{AtomicI32, Ordering};
+        use std::time::Duration;
+
+        /// Whether CPU-time clocks are available.
+        pub const CPU_CLOCKS: bool = true;
+
+        /// `struct timespec` of 64-bit Linux.
+        #[repr(C)]
+        struct Timespec {
+            tv_sec: c_long,
+            tv_nsec: c_long,
+        }
+
+        /// Linux clock ids (`<linux/time.h>`).
+        const CLOCK_MONOTONIC: c_int = 1;
+        const CLOCK_PROCESS_CPUTIME_ID: c_int = 2;
+        const CLOCK_THREAD_CPUTIME_ID: c_int = 3;
+
+        unsafe extern "C" {
+            fn clock_gettime(clock: c_int, tp: *mut Timespec) -> c_int;
+        }
+
+        /// The clock every [`Clock`] reads.
+        static SELECTED: AtomicI32 = AtomicI32::new(CLOCK_THREAD_CPUTIME_ID);
+
+        /// Makes every following measurement read `kind` (benchmarks run one after another).
+        pub fn select(kind: Kind) {
+            let id = match kind {
+                Kind::Thread => CLOCK_THREAD_CPUTIME_ID,
+                Kind::Process => CLOCK_PROCESS_CPUTIME_ID,
+                Kind::Wall => CLOCK_MONOTONIC,
+            };
+            SELECTED.store(id, Ordering::SeqCst);
+        }
+
+        fn now() -> Duration {
+            let id = SELECTED.load(Ordering::SeqCst);
+            let mut t = Timespec {
+                tv_sec: 0,
+                tv_nsec: 0,
+            };
+            // SAFETY: `t` is a valid, writable `timespec`; the call only writes into it.
+            let rc = unsafe { clock_gettime(id, &mut t) };
+            assert_eq!(rc, 0, "clock_gettime({id}) failed");
+            Duration::new(t.tv_sec as u64, t.tv_nsec as u32)
+        }
+
+        /// Durations are formatted as wall time is.
+        static FORMAT: WallTime = WallTime;
+
+        /// The selected clock as a criterion measurement.
+        pub struct Clock;
+
+        impl Measurement for Clock {
+            type Intermediate = Duration;
+            type Value = Duration;
+            fn start(&self) -> Duration {
+                now()
+            }
+            fn end(&self, start: Duration) -> Duration {
+                now().saturating_sub(start)
+            }
+            fn add(&self, a: &Duration, b: &Duration) -> Duration {
+                *a + *b
+            }
+            fn zero(&self) -> Duration {
+                Duration::ZERO
+            }
+            fn to_f64(&self, v: &Duration) -> f64 {
+                v.as_nanos() as f64
+            }
+            fn formatter(&self) -> &dyn ValueFormatter {
+                FORMAT.formatter()
+            }
+        }
+    }
+
+    /// Wall time only.
+    #[cfg(not(all(target_os = "linux", target_pointer_width = "64")))]
+    pub const CPU_CLOCKS: bool = false;
+
+    /// Wall time only.
+    #[cfg(not(all(target_os = "linux", target_pointer_width = "64")))]
+    pub type Clock = criterion::measurement::WallTime;
+
+    /// Wall time only: nothing to select.
+    #[cfg(not(all(target_os = "linux", target_pointer_width = "64")))]
+    pub fn select(_kind: Kind) {}
+}
+
+use clock::Clock;
 
 /// Calls per timed iteration.
 const BATCH: usize = 1024;
@@ -102,7 +230,7 @@ impl Op {
 }
 
 /// Times `op` of `b` over the whole batch, one call per input.
-fn bench_op<B: Bxdf>(g: &mut BenchmarkGroup<'_, WallTime>, id: &str, b: &B, op: Op, xs: &[Input]) {
+fn bench_op<B: Bxdf>(g: &mut BenchmarkGroup<'_, Clock>, id: &str, b: &B, op: Op, xs: &[Input]) {
     match op {
         Op::Eval => g.bench_function(id, |bn| {
             bn.iter(|| {
@@ -124,7 +252,7 @@ fn bench_op<B: Bxdf>(g: &mut BenchmarkGroup<'_, WallTime>, id: &str, b: &B, op: 
 }
 
 /// A group whose every benchmark processes one batch per iteration.
-fn group<'a>(c: &'a mut Criterion, name: &str) -> BenchmarkGroup<'a, WallTime> {
+fn group<'a>(c: &'a mut Criterion<Clock>, name: &str) -> BenchmarkGroup<'a, Clock> {
     let mut g = c.benchmark_group(name);
     g.throughput(Throughput::Elements(BATCH as u64));
     g
@@ -137,7 +265,7 @@ fn blinn(m: f32) -> MicrofacetDistribution {
 
 /// Single components, each with the parameters of a typical catalogue layer (m = 12°, η = 1.5,
 /// aluminium).
-fn components(c: &mut Criterion) {
+fn components(c: &mut Criterion<Clock>) {
     let (al_n, al_k) = Metal::Aluminium.nk();
     let ts_d = |mode| TorranceSparrow::new(blinn(12.0), Fresnel::dielectric(1.5, mode));
     let ts_c = |mode| TorranceSparrow::new(blinn(12.0), Fresnel::conductor(al_n, al_k, mode));
@@ -195,7 +323,7 @@ fn models() -> [(&'static str, Model); 3] {
 }
 
 /// Every catalogue material under every model (tables built once, outside the timing).
-fn materials(c: &mut Criterion) {
+fn materials(c: &mut Criterion<Clock>) {
     let lib = MaterialLibrary::course();
     let xs = batch(0xbe_0003, false);
     for (model_name, model) in models() {
@@ -220,14 +348,25 @@ fn materials(c: &mut Criterion) {
 
 /// What a compiled scene pays once per material: validating the description and building the
 /// stack's tables (`LayeredBsdf::new`). Course and Corrected build the same tables; a compensated
-/// Reference stack also builds its interfaces' energy tables.
-fn build(c: &mut Criterion) {
+/// Reference stack also builds its interfaces' energy tables. Table builds run in parallel (rayon),
+/// so these are timed by the wall clock (latency) and, for Corrected, by the process's CPU time
+/// (total work over all threads).
+fn build(c: &mut Criterion<Clock>) {
     let lib = MaterialLibrary::course();
-    for (model_name, model) in [
-        ("corrected", Model::Corrected),
-        ("reference", Model::Reference(ReferenceParams::default())),
-    ] {
-        let mut g = c.benchmark_group(format!("material_build_{model_name}"));
+    let mut cases = vec![
+        ("corrected", Model::Corrected, clock::Kind::Wall),
+        (
+            "reference",
+            Model::Reference(ReferenceParams::default()),
+            clock::Kind::Wall,
+        ),
+    ];
+    if clock::CPU_CLOCKS {
+        cases.push(("corrected_cpu", Model::Corrected, clock::Kind::Process));
+    }
+    for (label, model, kind) in cases {
+        clock::select(kind);
+        let mut g = c.benchmark_group(format!("material_build_{label}"));
         g.sampling_mode(SamplingMode::Flat)
             .sample_size(10)
             .measurement_time(Duration::from_secs(2));
@@ -240,17 +379,18 @@ fn build(c: &mut Criterion) {
         }
         g.finish();
     }
+    clock::select(clock::Kind::Thread);
 }
 
-/// The course's comparison (§3.4.2): a one-coat stack — a dielectric Torrance–Sparrow coat
-/// (η = 1.5, m = 12°, clear) over a Lambert base — against the coat's Torrance–Sparrow lobe alone,
-/// with precomputed (table) and with exact Fresnel.
-fn ratio(c: &mut Criterion) {
+/// The course's comparison (§3.4.2): a one-coat stack — a tinted dielectric Torrance–Sparrow coat
+/// (η = 1.5, m = 12°; the course's cost includes the Lambert–Beer term) over a Lambert base —
+/// against the coat's Torrance–Sparrow lobe alone, with precomputed (table) and exact Fresnel.
+fn ratio(c: &mut Criterion<Clock>) {
     let coat = Coat {
         ior: 1.5,
         roughness: 12.0,
-        absorption: Spectrum::ZERO,
-        thickness: 0.0,
+        absorption: Spectrum::rgb(0.1, 0.2, 0.4),
+        thickness: 1.0,
     };
     let base = Base::Lambert {
         albedo: Spectrum::splat(0.5),
@@ -285,8 +425,9 @@ fn ratio(c: &mut Criterion) {
 }
 
 /// Short runs: the whole file takes about five minutes on two cores.
-fn config() -> Criterion {
+fn config() -> Criterion<Clock> {
     Criterion::default()
+        .with_measurement(clock::measurement())
         .warm_up_time(Duration::from_millis(300))
         .measurement_time(Duration::from_secs(1))
         .sample_size(20)
