@@ -45,7 +45,10 @@ pub fn eval(stack: &LayeredBsdf, l: usize, wo: Vec3, wi: Vec3) -> Spectrum {
         return f;
     };
     let (to, ti) = (lv.t(wo.z), lv.t(wi.z));
-    if let Some(wi_in) = refract_macro(wi, lv.eta) {
+    let Some(wi_in) = refract_macro(wi, lv.eta) else {
+        return f;
+    };
+    {
         let rest = eval(stack, l + 1, wo_in, wi_in);
         if !rest.is_black() {
             let exit = if stack.t_term() {
@@ -62,8 +65,9 @@ pub fn eval(stack: &LayeredBsdf, l: usize, wo: Vec3, wi: Vec3) -> Spectrum {
             f += rest * absorption(lv.od, wo_in.z, wi_in.z) * (ti * exit / (lv.eta * lv.eta));
         }
     }
-    // Symmetric multiple-reflection lobe M · q(wo) q(wi) / ∫q cos (module docs).
-    let qi = refract_macro(wi, lv.eta).map_or(Spectrum::ZERO, |w| lv.trapped.at(w.z) * ti);
+    // Symmetric multiple-reflection lobe M · q(wo) q(wi) / ∫q cos (module docs); q(wi) = 0
+    // when wi cannot be reached from inside.
+    let qi = lv.trapped.at(wi_in.z) * ti;
     f + lv.trapped.at(wo_in.z) * qi * lv.multi_scale * to
 }
 
