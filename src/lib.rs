@@ -34,3 +34,4 @@ pub mod cli;
 pub mod color;
 pub mod recipe;
 pub mod sampler;
+pub mod texture;
