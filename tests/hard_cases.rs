@@ -603,6 +603,24 @@ fn check_stack(stack: &LayeredBsdf, desc: &StackDesc, q: &Query) -> Check {
         .map_err(|e| format!("{:?}: {e}", stack.model()))
 }
 
+/// `eval` is finite and non-negative and `pdf` finite and ≥ 0 for every query.
+fn eval_and_pdf_are_finite<'a>(
+    stack: &LayeredBsdf,
+    queries: impl Iterator<Item = &'a Query>,
+) -> Result<(), String> {
+    for q in queries {
+        let (wo, wi) = (q.wo, q.wi());
+        let f = stack.eval(wo, wi);
+        let p = stack.pdf(wo, wi);
+        ensure!(
+            f.is_valid() && p.is_finite() && p >= 0.0,
+            "{:?}: eval({wo:?}, {wi:?}) = {f:?}, pdf {p}",
+            stack.model()
+        );
+    }
+    Ok(())
+}
+
 /// The stack of `desc` under each of the three models.
 fn build_all_models(desc: &StackDesc) -> Result<Vec<LayeredBsdf>, String> {
     let built = catch_unwind(AssertUnwindSafe(|| LayeredBsdf::new(desc)))
@@ -1393,16 +1411,7 @@ fn construction_accepts_range_edges() {
         let mut d = StackDesc::new(coats.clone(), *base);
         d.fresnel = FresnelMode::Table;
         for stack in build_all_models(&d)? {
-            for q in edge_queries().iter().step_by(5) {
-                let (wo, wi) = (q.wo, q.wi());
-                let f = stack.eval(wo, wi);
-                let p = stack.pdf(wo, wi);
-                ensure!(
-                    f.is_valid() && p.is_finite() && p >= 0.0,
-                    "{:?}: eval({wo:?}, {wi:?}) = {f:?}, pdf {p}",
-                    stack.model()
-                );
-            }
+            eval_and_pdf_are_finite(&stack, edge_queries().iter().step_by(5))?;
         }
         Ok(())
     });
@@ -1833,16 +1842,7 @@ fn construction_property(cases: u32) {
         (desc, prop::collection::vec(query_with(view_direction()), 2)),
         |(desc, queries)| {
             for stack in build_all_models(&desc)? {
-                for q in &queries {
-                    let (wo, wi) = (q.wo, q.wi());
-                    let f = stack.eval(wo, wi);
-                    let p = stack.pdf(wo, wi);
-                    ensure!(
-                        f.is_valid() && p.is_finite() && p >= 0.0,
-                        "{:?}: eval({wo:?}, {wi:?}) = {f:?}, pdf {p}",
-                        stack.model()
-                    );
-                }
+                eval_and_pdf_are_finite(&stack, queries.iter())?;
             }
             Ok(())
         },
