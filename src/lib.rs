@@ -32,6 +32,7 @@
 pub mod bsdf;
 pub mod cli;
 pub mod color;
+pub mod geometry;
 pub mod recipe;
 pub mod sampler;
 pub mod texture;

@@ -1,8 +1,23 @@
 //! Procedural solid textures over object-space positions (course §5.2.1; DESIGN §4).
 //!
-//! Today: the cellular basis ([`voronoi`]). Fields (Perlin, fBm, marble) and the map tree that picks
-//! a layered material per cell build on it.
+//! - [`voronoi`]: the exact, seedable cellular basis (F1, F2, edge distance, 64-bit cell ids).
+//! - [`perlin`]: hashed-lattice gradient noise, fBm and turbulence.
+//! - [`field`]: scalar fields (Perlin, turbulence, marble, sums, products, remaps) in a flat table.
+//! - [`bump`]: the crystal-facet bump map (tilt distributions, the rule for facets seen from behind).
+//! - [`map`]: the runtime map tree — Voronoi surface and glitter maps, overlays, switches, material
+//!   leaves — and its allocation-free lookup.
+//!
+//! Everything here is a pure function of the position, the seeds and (for stochastic switch bands)
+//! one random number, and every type is `Send + Sync`: lookups agree bit for bit on any thread.
 
+pub mod bump;
+pub mod field;
+pub mod map;
+pub mod perlin;
 pub mod voronoi;
 
-pub use voronoi::{Voronoi, VoronoiSample};
+pub use bump::{FacetBump, Tilt};
+pub use field::{FieldId, FieldNode, FieldTable};
+pub use map::{CellTrail, Entry, Map, MapError, MapHit, MapNode, NodeId, Stop, VoronoiNode};
+pub use perlin::{Octaves, perlin};
+pub use voronoi::{Voronoi, VoronoiNearest, VoronoiSample};

@@ -13,11 +13,19 @@
 //! `|x − pj| < F1 + 2·edge`). The `noise` crate's Worley was not used: it offers 256 cell values,
 //! no F2 or edge distance, an incomplete neighbourhood and is `!Send` (DESIGN §4).
 //!
-//! Precision: cells are found with `f64` floors and offsets are formed relative to the cell, so
-//! cell ids stay exact for coordinates up to ±2³¹ cells; an `f32` input itself resolves positions to
-//! `|x|·2⁻²⁴`, i.e. the pattern is exact to 1/16 of a cell at |x| = 10⁶ and degrades beyond.
+//! Cells a point cannot reach are culled by their box distance before they are hashed, so a typical
+//! lookup hashes 8–15 of the 27 neighbours; [`Voronoi::nearest`] (F1 and the id only) stops as soon
+//! as no cell can beat F1, [`Voronoi::sample`] continues for F2 and the edge distance.
+//!
+//! Precision: cells are found with `f64` floors and offsets are formed relative to the cell, so the
+//! arithmetic is exact to ±2³¹ cells. The limit is the `f32` input: a coordinate `x` (in cell units)
+//! is known to `ulp(x) = 2^(⌊log₂|x|⌋ − 23)`. The cell a point falls in is therefore exact while
+//! `|x| < 2²⁴ = 16 777 216` cells (every integer is representable), the pattern inside a cell keeps
+//! better than 1/1000 of a cell below `|x| < 2¹³ = 8192` cells, and it is resolved only to 1/16 of a
+//! cell at `|x| = 10⁶`. Recipes divide object coordinates (≈ 1) by cell sizes (≥ 10⁻³), so they stay
+//! below 10⁴ cells.
 
-use crate::sampler::{hash_words, mix64, to_unit_f32};
+use crate::sampler::mix64;
 use glam::{DVec3, IVec3, Vec3};
 
 /// A Voronoi basis: `scale` is applied by the caller (positions are in cell units).
@@ -27,6 +35,19 @@ pub struct Voronoi {
     pub seed: u64,
     /// Feature-point jitter, 0 (regular grid of cell centres) … 1 (anywhere in the cell).
     pub jitter: f32,
+    /// `mix64(seed)`, the key every cell hash starts from.
+    key: u64,
+}
+
+/// The result of a nearest-point lookup ([`Voronoi::nearest`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VoronoiNearest {
+    /// Distance to the nearest feature point.
+    pub f1: f32,
+    /// Lattice cell of the nearest feature point.
+    pub cell: IVec3,
+    /// 64-bit hashed id of that cell (depends on the seed).
+    pub id: u64,
 }
 
 /// The result of one lookup.
@@ -56,33 +77,76 @@ impl Voronoi {
             } else {
                 1.0
             },
+            key: mix64(seed ^ 0x5851_f42d_4c95_7f2d),
         }
     }
 
-    /// The 64-bit id of lattice cell `c`.
+    /// The 64-bit id of lattice cell `c`: two SplitMix64 rounds, the first over `(x, y)` packed
+    /// into one word (a bijection), the second adding `z`.
     #[inline]
     pub fn cell_id(&self, c: IVec3) -> u64 {
-        hash_words(&[
-            self.seed,
-            c.x as u32 as u64,
-            c.y as u32 as u64,
-            c.z as u32 as u64,
-        ])
+        let xy = u64::from(c.x as u32) | (u64::from(c.y as u32) << 32);
+        mix64(mix64(self.key ^ xy) ^ u64::from(c.z as u32))
     }
 
-    /// Feature point of cell `c` relative to the cell's corner, in `[0, 1)³`.
+    /// Feature point of the cell with id `id`, relative to the cell's corner, in `[0, 1)³`: three
+    /// 21-bit uniforms from one further hash of the id.
     #[inline]
     fn offset(&self, id: u64) -> DVec3 {
-        let (a, b) = (
-            mix64(id ^ 0x51_7cc1_b727_220a),
-            mix64(id ^ 0x2545_f491_4f6c_dd1d),
-        );
+        const UNIT: f64 = 1.0 / (1u64 << 21) as f64;
+        const MASK: u64 = (1 << 21) - 1;
+        let a = mix64(id ^ 0x2545_f491_4f6c_dd1d);
         let r = DVec3::new(
-            f64::from(to_unit_f32(a)),
-            f64::from(to_unit_f32(a << 24)),
-            f64::from(to_unit_f32(b)),
+            (a & MASK) as f64 * UNIT,
+            ((a >> 21) & MASK) as f64 * UNIT,
+            ((a >> 42) & MASK) as f64 * UNIT,
         );
         DVec3::splat(0.5) + f64::from(self.jitter) * (r - DVec3::splat(0.5))
+    }
+
+    /// Nearest feature point only (F1, its cell and id): the cheap lookup maps use to pick a
+    /// cell. Agrees with [`Voronoi::sample`] on `f1`, `cell` and `id`.
+    pub fn nearest(&self, p: Vec3) -> VoronoiNearest {
+        let p = if p.is_finite() {
+            p.as_dvec3()
+        } else {
+            DVec3::ZERO
+        };
+        let base = p.floor();
+        let local = p - base;
+        let bc = IVec3::new(base.x as i32, base.y as i32, base.z as i32);
+        let (lo, hi) = (local * local, (DVec3::ONE - local) * (DVec3::ONE - local));
+        let mut d1 = f64::INFINITY;
+        let (mut c1, mut id1) = (bc, 0u64);
+        for o in NEIGHBOURS {
+            if box_distance_sq(o, lo, hi) >= d1 {
+                continue;
+            }
+            let c = bc + o;
+            let id = self.cell_id(c);
+            let d = (o.as_dvec3() + self.offset(id) - local).length_squared();
+            if d < d1 {
+                (d1, c1, id1) = (d, c, id);
+            }
+        }
+        // Shells beyond the 3×3×3 block can hold the nearest point only for high jitter.
+        let mut k = 2;
+        while k <= 4 && shell_min(local, k).powi(2) < d1 {
+            for_shell(k, |o| {
+                let c = bc + o;
+                let id = self.cell_id(c);
+                let d = (o.as_dvec3() + self.offset(id) - local).length_squared();
+                if d < d1 {
+                    (d1, c1, id1) = (d, c, id);
+                }
+            });
+            k += 1;
+        }
+        VoronoiNearest {
+            f1: d1.sqrt() as f32,
+            cell: c1,
+            id: id1,
+        }
     }
 
     /// Looks up position `p` (cell units). Finite inputs never produce NaN.
@@ -101,32 +165,31 @@ impl Voronoi {
             let id = self.cell_id(c);
             (o.as_dvec3() + self.offset(id), c, id)
         };
-        // Distance from `local` to the nearest point of the cells in shell k (Chebyshev radius k).
-        let shell_min = |k: i32| {
-            let d = local.min(DVec3::ONE - local).min_element();
-            f64::from(k - 1) + d
-        };
-        let (mut d1, mut d2) = (f64::INFINITY, f64::INFINITY);
-        let (mut p1, mut c1, mut id1) = (DVec3::ZERO, bc, 0u64);
-        let mut k = 1;
-        loop {
-            for_shell(k, |o| {
-                let (q, c, id) = point(o);
-                let d = (q - local).length_squared();
-                if d < d1 {
-                    d2 = d1;
-                    d1 = d;
-                    (p1, c1, id1) = (q, c, id);
-                } else if d < d2 {
-                    d2 = d;
-                }
-            });
-            let next = shell_min(k + 1);
-            if next * next >= d2 || k >= 4 {
-                break;
+        let shell_min = |k: i32| shell_min(local, k);
+        // Best two so far: (squared distance, point, cell, id) of the nearest, squared F2.
+        let mut best = (f64::INFINITY, DVec3::ZERO, bc, 0u64, f64::INFINITY);
+        let consider = |best: &mut (f64, DVec3, IVec3, u64, f64), o: IVec3| {
+            let (q, c, id) = point(o);
+            let d = (q - local).length_squared();
+            if d < best.0 {
+                *best = (d, q, c, id, best.0);
+            } else if d < best.4 {
+                best.4 = d;
             }
+        };
+        let (lo, hi) = (local * local, (DVec3::ONE - local) * (DVec3::ONE - local));
+        for o in NEIGHBOURS {
+            // A cell whose box is farther than F2 cannot change F1 or F2.
+            if box_distance_sq(o, lo, hi) < best.4 {
+                consider(&mut best, o);
+            }
+        }
+        let mut k = 2;
+        while k <= 4 && shell_min(k).powi(2) < best.4 {
+            for_shell(k, |o| consider(&mut best, o));
             k += 1;
         }
+        let (d1, p1, c1, id1, d2) = best;
         let f1 = d1.sqrt();
         // Edge: bisector distances, over shells around the F1 cell's neighbourhood while a shell
         // may hold a point closer than f1 + 2·edge.
@@ -159,6 +222,45 @@ impl Voronoi {
             feature: (base + p1).as_vec3(),
         }
     }
+}
+
+/// The 27 offsets of the 3×3×3 block, home cell first, then faces, edges and corners, so the
+/// nearest point is usually found early and farther cells are culled by their box distance.
+const NEIGHBOURS: [IVec3; 27] = {
+    let mut out = [IVec3::ZERO; 27];
+    let mut n = 0;
+    let mut ring = 0;
+    while ring <= 3 {
+        let mut i = 0;
+        while i < 27 {
+            let o = IVec3::new(i % 3 - 1, (i / 3) % 3 - 1, i / 9 - 1);
+            if o.x.abs() + o.y.abs() + o.z.abs() == ring {
+                out[n] = o;
+                n += 1;
+            }
+            i += 1;
+        }
+        ring += 1;
+    }
+    out
+};
+
+/// Squared distance from the point at `local ∈ [0,1)³` to the box of the neighbour cell at offset
+/// `o` (components −1, 0, 1); `lo = local²`, `hi = (1 − local)²` per axis.
+#[inline]
+fn box_distance_sq(o: IVec3, lo: DVec3, hi: DVec3) -> f64 {
+    let axis = |o: i32, lo: f64, hi: f64| match o {
+        -1 => lo,
+        1 => hi,
+        _ => 0.0,
+    };
+    axis(o.x, lo.x, hi.x) + axis(o.y, lo.y, hi.y) + axis(o.z, lo.z, hi.z)
+}
+
+/// Distance from `local` to the nearest point of the cells in shell `k` (Chebyshev radius `k`).
+#[inline]
+fn shell_min(local: DVec3, k: i32) -> f64 {
+    f64::from(k - 1) + local.min(DVec3::ONE - local).min_element()
 }
 
 /// Calls `f` for every cell offset of search shell `k`: shell 1 is the 3×3×3 block around the
@@ -233,6 +335,19 @@ mod tests {
                 s.edge
             );
             assert!(s.f1 <= s.f2 && s.edge >= 0.0);
+        }
+    }
+
+    #[test]
+    fn nearest_agrees_with_full_lookup() {
+        for jitter in [0.0, 0.5, 1.0] {
+            let v = Voronoi::new(19, jitter);
+            let mut rng = Rng::new(5);
+            for _ in 0..5000 {
+                let p = (Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) - 0.5) * 60.0;
+                let (a, b) = (v.nearest(p), v.sample(p));
+                assert_eq!((a.f1, a.cell, a.id), (b.f1, b.cell, b.id), "{p:?}");
+            }
         }
     }
 

@@ -1,0 +1,267 @@
+//! Scalar fields over object space: the functions a `Switch` compares with its thresholds.
+//!
+//! A [`FieldTable`] is a flat array of [`FieldNode`]s; composite nodes name their inputs by index
+//! into the same table, so evaluating a field walks indices and never allocates.
+//!
+//! | node | value | range |
+//! |---|---|---|
+//! | `Constant(c)` | `c` | — |
+//! | `Fbm` | fBm of [`perlin`](super::perlin::perlin) at `p / scale` | ≈ −1 … 1 |
+//! | `Turbulence` | `Σ gainᵏ·|noise|` (Perlin 1985) | 0 … 1 |
+//! | `Marble` | `½ + ½ sin(2π (a·p/scale + turbulence · turb(p/scale)))` (Perlin 1985's marble) | 0 … 1 |
+//! | `Sum`, `Product` | of the inputs | — |
+//! | `Remap` | `to.0 + (v − from.0)/(from.1 − from.0)·(to.1 − to.0)`, optionally clamped | — |
+//!
+//! `scale` is a length in object units: the lattice spacing of the first octave (Perlin) or the
+//! stripe spacing (Marble).
+
+use super::perlin::Octaves;
+use glam::Vec3;
+use std::f32::consts::TAU;
+
+/// Index of a field in its [`FieldTable`].
+pub type FieldId = u32;
+
+/// One field node (see the module table).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FieldNode {
+    /// A constant.
+    Constant(f32),
+    /// Fractional Brownian motion of Perlin noise.
+    Fbm {
+        /// `1 / scale` (object units⁻¹).
+        inv_scale: f32,
+        /// Octave parameters.
+        octaves: Octaves,
+    },
+    /// Turbulence: the fBm of `|noise|`.
+    Turbulence {
+        /// `1 / scale` (object units⁻¹).
+        inv_scale: f32,
+        /// Octave parameters.
+        octaves: Octaves,
+    },
+    /// Marble veins: a sine of an axis coordinate perturbed by turbulence.
+    Marble {
+        /// `1 / scale`: veins per object unit along `axis`.
+        inv_scale: f32,
+        /// Unit vector across the veins.
+        axis: Vec3,
+        /// Amplitude of the turbulence, in vein periods.
+        turbulence: f32,
+        /// Octave parameters of the turbulence.
+        octaves: Octaves,
+    },
+    /// Sum of `count` inputs listed from `first` in the table's argument list.
+    Sum {
+        /// First argument slot.
+        first: u32,
+        /// Number of inputs.
+        count: u32,
+    },
+    /// Product of `count` inputs listed from `first`.
+    Product {
+        /// First argument slot.
+        first: u32,
+        /// Number of inputs.
+        count: u32,
+    },
+    /// Linear remap of one input from `from` to `to`.
+    Remap {
+        /// The input field.
+        input: FieldId,
+        /// Source interval (distinct ends).
+        from: [f32; 2],
+        /// Target interval.
+        to: [f32; 2],
+        /// Clamp the result to the target interval.
+        clamp: bool,
+    },
+}
+
+/// A flat table of fields.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FieldTable {
+    nodes: Vec<FieldNode>,
+    args: Vec<FieldId>,
+}
+
+impl FieldTable {
+    /// Appends a node and returns its id. Inputs of composite nodes must already be in the table
+    /// (children before parents), which makes cycles impossible; [`FieldTable::add`] checks it.
+    pub fn add(&mut self, node: FieldNode) -> Result<FieldId, String> {
+        let id = self.nodes.len() as FieldId;
+        let ok = |f: FieldId| f < id;
+        let valid = match node {
+            FieldNode::Sum { first, count } | FieldNode::Product { first, count } => self
+                .args
+                .get(first as usize..(first + count) as usize)
+                .is_some_and(|a| a.iter().all(|&f| ok(f))),
+            FieldNode::Remap { input, from, .. } => ok(input) && from[0] != from[1],
+            _ => true,
+        };
+        if !valid {
+            return Err(format!("field {id}: inputs must be earlier fields"));
+        }
+        self.nodes.push(node);
+        Ok(id)
+    }
+
+    /// Stores an argument list for `Sum`/`Product` and returns `(first, count)`.
+    pub fn add_args(&mut self, ids: &[FieldId]) -> (u32, u32) {
+        let first = self.args.len() as u32;
+        self.args.extend_from_slice(ids);
+        (first, ids.len() as u32)
+    }
+
+    /// Number of nodes.
+    pub fn len(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// Whether the table is empty.
+    pub fn is_empty(&self) -> bool {
+        self.nodes.is_empty()
+    }
+
+    /// The nodes, in insertion order.
+    pub fn nodes(&self) -> &[FieldNode] {
+        &self.nodes
+    }
+
+    /// Value of field `id` at object-space point `p`. Finite for finite parameters and any `p`.
+    pub fn eval(&self, id: FieldId, p: Vec3) -> f32 {
+        match self.nodes[id as usize] {
+            FieldNode::Constant(c) => c,
+            FieldNode::Fbm { inv_scale, octaves } => octaves.fbm(p * inv_scale),
+            FieldNode::Turbulence { inv_scale, octaves } => octaves.turbulence(p * inv_scale),
+            FieldNode::Marble {
+                inv_scale,
+                axis,
+                turbulence,
+                octaves,
+            } => {
+                let q = p * inv_scale;
+                let phase = axis.dot(q) + turbulence * octaves.turbulence(q);
+                // Reduce the phase first so large coordinates keep the sine accurate.
+                0.5 + 0.5 * (TAU * (phase - phase.floor())).sin()
+            }
+            FieldNode::Sum { first, count } => self.args[first as usize..(first + count) as usize]
+                .iter()
+                .map(|&f| self.eval(f, p))
+                .sum(),
+            FieldNode::Product { first, count } => self.args
+                [first as usize..(first + count) as usize]
+                .iter()
+                .map(|&f| self.eval(f, p))
+                .product(),
+            FieldNode::Remap {
+                input,
+                from,
+                to,
+                clamp,
+            } => {
+                let t = (self.eval(input, p) - from[0]) / (from[1] - from[0]);
+                let t = if clamp { t.clamp(0.0, 1.0) } else { t };
+                to[0] + t * (to[1] - to[0])
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampler::Rng;
+
+    fn octaves(seed: u32) -> Octaves {
+        Octaves {
+            octaves: 4,
+            gain: 0.5,
+            lacunarity: 2.0,
+            seed,
+        }
+    }
+
+    #[test]
+    fn composites_combine_their_inputs() {
+        let mut t = FieldTable::default();
+        let a = t
+            .add(FieldNode::Fbm {
+                inv_scale: 3.0,
+                octaves: octaves(1),
+            })
+            .unwrap();
+        let b = t.add(FieldNode::Constant(0.25)).unwrap();
+        let (first, count) = t.add_args(&[a, b]);
+        let sum = t.add(FieldNode::Sum { first, count }).unwrap();
+        let prod = t.add(FieldNode::Product { first, count }).unwrap();
+        let remap = t
+            .add(FieldNode::Remap {
+                input: a,
+                from: [-1.0, 1.0],
+                to: [0.0, 1.0],
+                clamp: true,
+            })
+            .unwrap();
+        let mut rng = Rng::new(3);
+        for _ in 0..1000 {
+            let p = Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * 4.0;
+            let va = t.eval(a, p);
+            assert!((t.eval(sum, p) - (va + 0.25)).abs() < 1e-6);
+            assert!((t.eval(prod, p) - va * 0.25).abs() < 1e-6);
+            let r = t.eval(remap, p);
+            assert!((0.0..=1.0).contains(&r) && (r - (va + 1.0) / 2.0).abs() < 1e-6);
+        }
+        // Inputs must come first: a forward reference is rejected.
+        let (first, count) = t.add_args(&[99]);
+        assert!(t.add(FieldNode::Sum { first, count }).is_err());
+        assert!(
+            t.add(FieldNode::Remap {
+                input: a,
+                from: [1.0, 1.0],
+                to: [0.0, 1.0],
+                clamp: false
+            })
+            .is_err()
+        );
+    }
+
+    #[test]
+    fn marble_is_a_turbulent_sine_and_stays_finite_far_out() {
+        let mut t = FieldTable::default();
+        let plain = t
+            .add(FieldNode::Marble {
+                inv_scale: 2.0,
+                axis: Vec3::X,
+                turbulence: 0.0,
+                octaves: octaves(2),
+            })
+            .unwrap();
+        let veined = t
+            .add(FieldNode::Marble {
+                inv_scale: 2.0,
+                axis: Vec3::X,
+                turbulence: 1.5,
+                octaves: octaves(2),
+            })
+            .unwrap();
+        // Without turbulence: ½ + ½ sin(2π·2x), independent of y and z.
+        for x in [0.0f32, 0.1, 0.125, 0.3] {
+            let want = 0.5 + 0.5 * (TAU * 2.0 * x).sin();
+            let got = t.eval(plain, Vec3::new(x, 7.0, -3.0));
+            assert!((got - want).abs() < 1e-5, "{x}: {got} vs {want}");
+        }
+        let mut differs = 0;
+        for i in 0..100 {
+            let p = Vec3::new(i as f32 * 0.013, i as f32 * 0.07, 0.5);
+            let v = t.eval(veined, p);
+            assert!((0.0..=1.0).contains(&v));
+            differs += usize::from((v - t.eval(plain, p)).abs() > 1e-3);
+        }
+        assert!(differs > 80, "turbulence bends the veins: {differs}");
+        for p in [Vec3::splat(1e6), Vec3::splat(-1e6), Vec3::ZERO] {
+            assert!(t.eval(veined, p).is_finite());
+        }
+    }
+}

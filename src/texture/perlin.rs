@@ -1,0 +1,230 @@
+//! Seedable 3-D gradient noise without a period, and its fractal sums.
+//!
+//! The noise is Perlin's "improved noise" (K. Perlin, "Improving Noise", SIGGRAPH 2002): gradients
+//! from the 12 cube-edge directions at the lattice corners, blended with the quintic fade
+//! `6t⁵ − 15t⁴ + 10t³` (C² continuous). Instead of a 256-entry permutation table — which repeats
+//! every 256 lattice units, a period that shows in a stone's fine octaves (octave 8 of an fBm repeats
+//! every 2 base units) — each corner's gradient comes from a 32-bit hash of `(seed, x, y, z)`, so the
+//! pattern repeats only after 2³² lattice units and any 32-bit seed gives an independent pattern.
+//!
+//! Why not the `noise` crate: its `Perlin` is the permutation-table kind (period 256, seeds shuffle
+//! one 256-entry table), and its `Fbm` keeps a `Vec` of sources built at construction; we want one
+//! `Copy` value per field in flat runtime tables. `benches/texture.rs` measures both implementations
+//! side by side (the figures are in `docs/cost.md`).
+//!
+//! Coordinates are floored in `f64` so the lattice stays exact for large inputs; the remainder is
+//! `f32`. Output of [`perlin`] lies in about `[−1, 1]` (zero at every lattice point).
+
+use glam::{DVec3, Vec3};
+
+/// The 32-bit integer hash "lowbias32" (C. Wellons, *hash-prospector*, 2018: two multiply–xorshift
+/// rounds with bias ≈ 0.17 ‰), used to pick corner gradients.
+#[inline]
+fn hash32(mut x: u32) -> u32 {
+    x ^= x >> 16;
+    x = x.wrapping_mul(0x7feb_352d);
+    x ^= x >> 15;
+    x = x.wrapping_mul(0x846c_a68b);
+    x ^ (x >> 16)
+}
+
+/// Dot product of corner gradient `h` (one of the 12 cube edges, 4 repeated to make 16, as in
+/// Perlin 2002) with the offset `(x, y, z)` from that corner.
+#[inline]
+fn grad(h: u32, x: f32, y: f32, z: f32) -> f32 {
+    let h = h >> 28; // the hash's best-mixed bits
+    let u = if h < 8 { x } else { y };
+    let v = if h < 4 {
+        y
+    } else if h == 12 || h == 14 {
+        x
+    } else {
+        z
+    };
+    (if h & 1 == 0 { u } else { -u }) + (if h & 2 == 0 { v } else { -v })
+}
+
+#[inline]
+fn fade(t: f32) -> f32 {
+    t * t * t * (t * (t * 6.0 - 15.0) + 10.0)
+}
+
+#[inline]
+fn lerp(t: f32, a: f32, b: f32) -> f32 {
+    a + t * (b - a)
+}
+
+/// Perlin gradient noise at `p` (lattice units) for `seed`; about `[−1, 1]`, finite for every
+/// input (non-finite inputs read as the origin).
+pub fn perlin(p: Vec3, seed: u32) -> f32 {
+    let p = if p.is_finite() {
+        p.as_dvec3()
+    } else {
+        DVec3::ZERO
+    };
+    let cell = p.floor();
+    let f = (p - cell).as_vec3();
+    // Lattice coordinates wrap at 2³² — far beyond any recipe (see the module docs).
+    let (xi, yi, zi) = (
+        cell.x as i64 as u32,
+        cell.y as i64 as u32,
+        cell.z as i64 as u32,
+    );
+    let s = hash32(seed ^ 0x9e37_79b9);
+    let hz = [hash32(s ^ zi), hash32(s ^ zi.wrapping_add(1))];
+    let hyz = |y: u32, z: usize| hash32(hz[z] ^ y.wrapping_mul(0x85eb_ca6b));
+    let corner = |x: u32, y: u32, z: usize| hash32(hyz(y, z) ^ x.wrapping_mul(0xc2b2_ae35));
+    let (x1, y1) = (xi.wrapping_add(1), yi.wrapping_add(1));
+    let (u, v, w) = (fade(f.x), fade(f.y), fade(f.z));
+    let (fx, fy, fz) = (f.x, f.y, f.z);
+    let z0 = lerp(
+        v,
+        lerp(
+            u,
+            grad(corner(xi, yi, 0), fx, fy, fz),
+            grad(corner(x1, yi, 0), fx - 1.0, fy, fz),
+        ),
+        lerp(
+            u,
+            grad(corner(xi, y1, 0), fx, fy - 1.0, fz),
+            grad(corner(x1, y1, 0), fx - 1.0, fy - 1.0, fz),
+        ),
+    );
+    let z1 = lerp(
+        v,
+        lerp(
+            u,
+            grad(corner(xi, yi, 1), fx, fy, fz - 1.0),
+            grad(corner(x1, yi, 1), fx - 1.0, fy, fz - 1.0),
+        ),
+        lerp(
+            u,
+            grad(corner(xi, y1, 1), fx, fy - 1.0, fz - 1.0),
+            grad(corner(x1, y1, 1), fx - 1.0, fy - 1.0, fz - 1.0),
+        ),
+    );
+    lerp(w, z0, z1)
+}
+
+/// Parameters of a fractal sum of [`perlin`] octaves.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Octaves {
+    /// Number of octaves, 1 … 16.
+    pub octaves: u32,
+    /// Amplitude ratio between successive octaves (0 … 1; 0.5 is classic fBm).
+    pub gain: f32,
+    /// Frequency ratio between successive octaves (> 1; 2 is classic).
+    pub lacunarity: f32,
+    /// Noise seed; octave `k` uses `seed + k` so octaves are independent.
+    pub seed: u32,
+}
+
+impl Octaves {
+    /// Fractional Brownian motion: `Σ gainᵏ · perlin(lacunarityᵏ p) / Σ gainᵏ`, about `[−1, 1]`.
+    pub fn fbm(&self, p: Vec3) -> f32 {
+        self.sum(p, |n| n)
+    }
+
+    /// Turbulence (Perlin 1985): `Σ gainᵏ · |perlin(lacunarityᵏ p)| / Σ gainᵏ`, in `[0, 1]`.
+    pub fn turbulence(&self, p: Vec3) -> f32 {
+        self.sum(p, f32::abs)
+    }
+
+    #[inline]
+    fn sum(&self, p: Vec3, shape: impl Fn(f32) -> f32) -> f32 {
+        let (mut total, mut norm) = (0.0, 0.0);
+        let (mut amp, mut freq) = (1.0f32, 1.0f32);
+        for k in 0..self.octaves.max(1) {
+            total += amp * shape(perlin(p * freq, self.seed.wrapping_add(k)));
+            norm += amp;
+            amp *= self.gain;
+            freq *= self.lacunarity;
+        }
+        if norm > 0.0 { total / norm } else { 0.0 }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampler::Rng;
+
+    fn points(n: usize, spread: f32, key: u64) -> Vec<Vec3> {
+        let mut rng = Rng::new(key);
+        (0..n)
+            .map(|_| (Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) - 0.5) * spread)
+            .collect()
+    }
+
+    #[test]
+    fn zero_on_lattice_bounded_and_continuous() {
+        for p in [Vec3::ZERO, Vec3::new(3.0, -7.0, 12.0), Vec3::splat(1e6)] {
+            assert_eq!(perlin(p, 4), 0.0, "{p:?}");
+        }
+        let mut max = 0.0f32;
+        for p in points(200_000, 50.0, 1) {
+            let n = perlin(p, 9);
+            assert!(n.is_finite() && n.abs() <= 1.1, "{p:?}: {n}");
+            max = max.max(n.abs());
+            // Lipschitz: the gradient of improved noise is bounded (< 4 per lattice unit).
+            let d = perlin(p + Vec3::new(1e-3, 0.0, 0.0), 9) - n;
+            assert!(d.abs() < 4e-3, "{p:?}: step {d}");
+        }
+        assert!(max > 0.7, "the range is used: max |n| = {max}");
+    }
+
+    #[test]
+    fn mean_zero_and_seeds_decorrelate() {
+        let pts = points(100_000, 200.0, 2);
+        let a: Vec<f32> = pts.iter().map(|&p| perlin(p, 1)).collect();
+        let b: Vec<f32> = pts.iter().map(|&p| perlin(p, 2)).collect();
+        let n = a.len() as f64;
+        let mean = a.iter().map(|&x| f64::from(x)).sum::<f64>() / n;
+        let var = a.iter().map(|&x| f64::from(x).powi(2)).sum::<f64>() / n;
+        let cov = a
+            .iter()
+            .zip(&b)
+            .map(|(&x, &y)| f64::from(x) * f64::from(y))
+            .sum::<f64>()
+            / n;
+        // Points 200 lattice units apart on average are independent: standard errors ≈ √(var/n).
+        let se = (var / n).sqrt();
+        assert!(mean.abs() < 5.0 * se, "mean {mean} (se {se})");
+        assert!(
+            (cov / var).abs() < 5.0 / n.sqrt(),
+            "correlation {}",
+            cov / var
+        );
+    }
+
+    #[test]
+    fn no_period_at_256_and_non_finite_input() {
+        // A permutation-table Perlin repeats here; the hashed lattice does not.
+        let mut same = 0;
+        for p in points(1000, 10.0, 3) {
+            if (perlin(p, 5) - perlin(p + Vec3::new(256.0, 0.0, 0.0), 5)).abs() < 1e-6 {
+                same += 1;
+            }
+        }
+        assert!(same < 10, "{same} of 1000 repeat");
+        assert_eq!(perlin(Vec3::NAN, 1), 0.0);
+        assert!(perlin(Vec3::splat(-1e6 + 0.37), 1).is_finite());
+    }
+
+    #[test]
+    fn fbm_and_turbulence_ranges() {
+        let o = Octaves {
+            octaves: 6,
+            gain: 0.5,
+            lacunarity: 2.0,
+            seed: 7,
+        };
+        for p in points(20_000, 20.0, 4) {
+            let (f, t) = (o.fbm(p), o.turbulence(p));
+            assert!(f.abs() <= 1.1 && (0.0..=1.0).contains(&t), "{f} {t}");
+        }
+        let one = Octaves { octaves: 1, ..o };
+        let p = Vec3::new(0.3, 0.7, 0.1);
+        assert_eq!(one.fbm(p), perlin(p, 7));
+    }
+}
