@@ -35,4 +35,5 @@ pub mod color;
 pub mod geometry;
 pub mod recipe;
 pub mod sampler;
+pub mod scene;
 pub mod texture;

@@ -2,6 +2,7 @@
 //! lives in its own file.
 
 pub mod brdf;
+pub mod map;
 pub mod plot;
 
 use clap::{Parser, Subcommand};
@@ -23,6 +24,9 @@ pub enum Command {
     /// Inspect a layered BRDF: list, evaluate, sample, measure albedo, plot. With no arguments it
     /// prints the albedo table of the built-in course catalogue under the three models.
     Brdf(brdf::BrdfArgs),
+    /// Draw a gem recipe's map tree on a plane (flat colour per material, glitter cells outlined,
+    /// facet tilt shaded) to a PNG, and print each material's share of the plane.
+    Map(map::MapArgs),
 }
 
 /// Parses the process arguments and runs; errors are printed as `error: …` and exit with 1.
@@ -30,6 +34,7 @@ pub fn run() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Brdf(args) => brdf::run(&args),
+        Command::Map(args) => map::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

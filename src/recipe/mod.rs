@@ -6,14 +6,18 @@
 //! and, for numbers, the allowed range; no input makes it panic.
 
 pub mod color;
+pub mod gem;
 pub mod material;
+pub mod surface;
 
 use crate::bsdf::{LayeredBsdf, Model};
+pub use gem::{GemDesc, GemRecipe};
 use indexmap::IndexMap;
 pub use material::{BaseDesc, CoatDesc, MaterialDesc, MetalDesc, ModelDesc};
 use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::path::Path;
+pub use surface::{BumpDesc, FieldDesc, MapDesc, SwitchDesc};
 
 /// The built-in course catalogue (`materials/course.ron`), compiled into the binary.
 pub const COURSE_CATALOGUE: &str = include_str!("../../materials/course.ron");
@@ -79,6 +83,16 @@ impl MaterialLibrary {
     pub fn course() -> Self {
         Self::parse("materials/course.ron", COURSE_CATALOGUE)
             .expect("the built-in catalogue parses (tested)")
+    }
+
+    /// A library over already-parsed content whose positions refer to `source` (a gem recipe's
+    /// `materials` section). Not validated: call [`MaterialLibrary::stack`] per name.
+    pub fn from_parts(file: &str, source: &str, content: MaterialFile) -> Self {
+        MaterialLibrary {
+            file: file.to_string(),
+            source: source.to_string(),
+            content,
+        }
     }
 
     /// Parses library text; `file` is used in messages.
@@ -158,9 +172,12 @@ impl MaterialLibrary {
     }
 }
 
-/// RON options shared by every description file: optional fields are written without `Some(..)`.
+/// RON options shared by every description file: optional fields are written without `Some(..)`,
+/// and a variant wrapping a struct is written `Switch(by: …)` rather than `Switch((by: …))`.
 pub fn ron_options() -> ron::Options {
-    ron::Options::default().with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME)
+    use ron::extensions::Extensions;
+    ron::Options::default()
+        .with_default_extension(Extensions::IMPLICIT_SOME | Extensions::UNWRAP_VARIANT_NEWTYPES)
 }
 
 /// Finds the position of the field a message starts with (e.g. `coats[1].ior`) within material
@@ -228,7 +245,7 @@ fn find_token(source: &str, from: usize, token: &str) -> Option<usize> {
     None
 }
 
-fn line_col(source: &str, pos: usize) -> (usize, usize) {
+pub(crate) fn line_col(source: &str, pos: usize) -> (usize, usize) {
     let before = &source[..pos.min(source.len())];
     let line = before.matches('\n').count() + 1;
     let col = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
