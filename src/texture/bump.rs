@@ -17,6 +17,7 @@
 //! weights by `|wi·n'|` and drops any `wi` below the unbumped surface, so the reflected fraction is
 //! at most the BSDF's albedo in that frame (≤ 1); tested in `tests/maps.rs`.
 
+use crate::geometry::Frame;
 use crate::sampler::{mix64, to_unit_f32};
 use glam::Vec3;
 use std::f32::consts::PI;
@@ -124,6 +125,14 @@ pub fn visible_normal(facet: Vec3, wo: Vec3) -> Vec3 {
     (Vec3::Z * beta.cos() + u * beta.sin()).normalize()
 }
 
+/// The shading frame for a facet: `frame` is the unbumped shading frame, `facet` the cell's normal
+/// in its tangent space, `wo` the world direction toward the viewer. Applies [`visible_normal`] and
+/// rebuilds the frame around the result ([`Frame::tilted`]). The caller evaluates the BSDF in the
+/// returned frame and must still reject directions below the unbumped surface (module docs).
+pub fn facet_frame(frame: &Frame, facet: Vec3, wo: Vec3) -> Frame {
+    frame.tilted(visible_normal(facet, frame.to_local(wo)))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -177,5 +186,20 @@ mod tests {
         }
         assert_eq!(visible_normal(facet, Vec3::new(1.0, 0.0, 0.0)), Vec3::Z);
         assert_eq!(visible_normal(Vec3::NAN, Vec3::Z), Vec3::Z);
+    }
+
+    #[test]
+    fn facet_frame_faces_the_viewer() {
+        let frame = Frame::from_normal(Vec3::new(0.2, -0.1, 0.97).normalize());
+        let facet = Vec3::new(0.5, 0.0, 0.866);
+        for wo_local in [
+            Vec3::new(0.3, 0.1, 0.95).normalize(),
+            Vec3::new(-0.99, 0.0, 0.14).normalize(),
+        ] {
+            let wo = frame.to_world(wo_local);
+            let f = facet_frame(&frame, facet, wo);
+            assert!(f.n.dot(wo) >= MIN_COS_WO - 1e-4, "{wo_local:?}");
+            assert!(f.n.dot(frame.n) > 0.0);
+        }
     }
 }
