@@ -129,8 +129,14 @@ impl FieldTable {
         &self.nodes
     }
 
-    /// Value of field `id` at object-space point `p`. Finite for finite parameters and any `p`.
+    /// Value of field `id` at object-space point `p`; always finite (a node whose value would
+    /// overflow or be undefined, e.g. marble at |p| ≈ 1e38, reads 0).
     pub fn eval(&self, id: FieldId, p: Vec3) -> f32 {
+        let v = self.eval_raw(id, p);
+        if v.is_finite() { v } else { 0.0 }
+    }
+
+    fn eval_raw(&self, id: FieldId, p: Vec3) -> f32 {
         match self.nodes[id as usize] {
             FieldNode::Constant(c) => c,
             FieldNode::Fbm { inv_scale, octaves } => octaves.fbm(p * inv_scale),
@@ -260,8 +266,15 @@ mod tests {
             differs += usize::from((v - t.eval(plain, p)).abs() > 1e-3);
         }
         assert!(differs > 80, "turbulence bends the veins: {differs}");
-        for p in [Vec3::splat(1e6), Vec3::splat(-1e6), Vec3::ZERO] {
-            assert!(t.eval(veined, p).is_finite());
+        for p in [
+            Vec3::splat(1e6),
+            Vec3::splat(-1e6),
+            Vec3::ZERO,
+            Vec3::splat(3e38),
+            Vec3::NAN,
+            Vec3::INFINITY,
+        ] {
+            assert!(t.eval(veined, p).is_finite(), "{p:?}");
         }
     }
 }

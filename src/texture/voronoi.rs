@@ -107,11 +107,7 @@ impl Voronoi {
     /// Nearest feature point only (F1, its cell and id): the cheap lookup maps use to pick a
     /// cell. Agrees with [`Voronoi::sample`] on `f1`, `cell` and `id`.
     pub fn nearest(&self, p: Vec3) -> VoronoiNearest {
-        let p = if p.is_finite() {
-            p.as_dvec3()
-        } else {
-            DVec3::ZERO
-        };
+        let p = clamp_input(p);
         let base = p.floor();
         let local = p - base;
         let bc = IVec3::new(base.x as i32, base.y as i32, base.z as i32);
@@ -151,11 +147,7 @@ impl Voronoi {
 
     /// Looks up position `p` (cell units). Finite inputs never produce NaN.
     pub fn sample(&self, p: Vec3) -> VoronoiSample {
-        let p = if p.is_finite() {
-            p.as_dvec3()
-        } else {
-            DVec3::ZERO
-        };
+        let p = clamp_input(p);
         let base = p.floor();
         let local = p - base; // in [0, 1)
         let bc = IVec3::new(base.x as i32, base.y as i32, base.z as i32);
@@ -221,6 +213,21 @@ impl Voronoi {
             id: id1,
             feature: (base + p1).as_vec3(),
         }
+    }
+}
+
+/// Largest |coordinate| looked up, in cells: beyond it inputs are clamped so neighbour-cell
+/// arithmetic cannot overflow `i32` (2³⁰, far past the 2²⁴ where `f32` inputs stop resolving cells).
+pub const MAX_CELLS: f64 = (1u64 << 30) as f64;
+
+/// The input in `f64`, non-finite read as the origin, clamped to ±[`MAX_CELLS`].
+#[inline]
+fn clamp_input(p: Vec3) -> DVec3 {
+    if p.is_finite() {
+        p.as_dvec3()
+            .clamp(DVec3::splat(-MAX_CELLS), DVec3::splat(MAX_CELLS))
+    } else {
+        DVec3::ZERO
     }
 }
 
@@ -403,6 +410,8 @@ mod tests {
             Vec3::splat(1e6),
             Vec3::splat(-1e6),
             Vec3::new(1e6, -1e6, 0.5),
+            Vec3::new(2.2e9, 0.0, -3e38),
+            Vec3::splat(f32::MAX),
         ] {
             let s = v.sample(p);
             assert!(
