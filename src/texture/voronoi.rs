@@ -81,25 +81,32 @@ impl Voronoi {
         }
     }
 
-    /// The 64-bit id of lattice cell `c`: two SplitMix64 rounds, the first over `(x, y)` packed
-    /// into one word (a bijection), the second adding `z`.
+    /// The 64-bit id of lattice cell `c`: one SplitMix64 round over the three coordinates packed
+    /// into 63 bits (a bijection while every |coordinate| < 2²⁰ cells, far beyond recipes), two
+    /// rounds beyond that.
     #[inline]
     pub fn cell_id(&self, c: IVec3) -> u64 {
-        let xy = u64::from(c.x as u32) | (u64::from(c.y as u32) << 32);
-        mix64(mix64(self.key ^ xy) ^ u64::from(c.z as u32))
+        const LIMIT: i32 = 1 << 20;
+        if c.abs().max_element() < LIMIT {
+            let pack = |v: i32| u64::from((v + LIMIT) as u32);
+            mix64(self.key ^ (pack(c.x) | pack(c.y) << 21 | pack(c.z) << 42))
+        } else {
+            let xy = u64::from(c.x as u32) | (u64::from(c.y as u32) << 32);
+            mix64(mix64(self.key ^ xy ^ (1 << 63)) ^ u64::from(c.z as u32))
+        }
     }
 
     /// Feature point of the cell with id `id`, relative to the cell's corner, in `[0, 1)³`: three
-    /// 21-bit uniforms from one further hash of the id.
+    /// 21-bit uniforms taken from the id's bits (the id is already a full-avalanche hash; the
+    /// entry pick and fill use further hashes of it).
     #[inline]
     fn offset(&self, id: u64) -> DVec3 {
         const UNIT: f64 = 1.0 / (1u64 << 21) as f64;
         const MASK: u64 = (1 << 21) - 1;
-        let a = mix64(id ^ 0x2545_f491_4f6c_dd1d);
         let r = DVec3::new(
-            (a & MASK) as f64 * UNIT,
-            ((a >> 21) & MASK) as f64 * UNIT,
-            ((a >> 42) & MASK) as f64 * UNIT,
+            (id & MASK) as f64 * UNIT,
+            ((id >> 21) & MASK) as f64 * UNIT,
+            ((id >> 42) & MASK) as f64 * UNIT,
         );
         DVec3::splat(0.5) + f64::from(self.jitter) * (r - DVec3::splat(0.5))
     }
