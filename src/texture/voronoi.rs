@@ -136,6 +136,9 @@ impl Voronoi {
         let mut k = 2;
         while k <= 4 && shell_min(local, k).powi(2) < d1 {
             for_shell(k, |o| {
+                if far_box_distance_sq(o, local) >= d1 {
+                    return;
+                }
                 let c = bc + o;
                 let id = self.cell_id(c);
                 let d = (o.as_dvec3() + self.offset(id) - local).length_squared();
@@ -185,7 +188,11 @@ impl Voronoi {
         }
         let mut k = 2;
         while k <= 4 && shell_min(k).powi(2) < best.4 {
-            for_shell(k, |o| consider(&mut best, o));
+            for_shell(k, |o| {
+                if far_box_distance_sq(o, local) < best.4 {
+                    consider(&mut best, o)
+                }
+            });
             k += 1;
         }
         let (d1, p1, c1, id1, d2) = best;
@@ -193,23 +200,31 @@ impl Voronoi {
         // Edge: bisector distances, over shells around the F1 cell's neighbourhood while a shell
         // may hold a point closer than f1 + 2·edge.
         let mut edge = f64::INFINITY;
-        let mut k = 1;
-        loop {
+        let mut bisector = |o: IVec3, edge: &mut f64| {
+            let (q, c, _) = point(o);
+            if c == c1 {
+                return;
+            }
+            let dq = (q - local).length_squared();
+            let sep = (q - p1).length();
+            if sep > 0.0 {
+                *edge = edge.min(((dq - d1) / (2.0 * sep)).max(0.0));
+            }
+        };
+        // The 3×3×3 block nearest first, culling boxes that cannot hold a point closer than
+        // f1 + 2·edge; then whole shells while one can.
+        for o in NEIGHBOURS {
+            if box_distance_sq(o, lo, hi) < (f1 + 2.0 * edge).powi(2) {
+                bisector(o, &mut edge);
+            }
+        }
+        let mut k = 2;
+        while k <= 5 && shell_min(k) < f1 + 2.0 * edge {
             for_shell(k, |o| {
-                let (q, c, _) = point(o);
-                if c == c1 {
-                    return;
-                }
-                let dq = (q - local).length_squared();
-                let sep = (q - p1).length();
-                if sep > 0.0 {
-                    edge = edge.min(((dq - d1) / (2.0 * sep)).max(0.0));
+                if far_box_distance_sq(o, local) < (f1 + 2.0 * edge).powi(2) {
+                    bisector(o, &mut edge)
                 }
             });
-            let next = shell_min(k + 1);
-            if next >= f1 + 2.0 * edge || k >= 5 {
-                break;
-            }
             k += 1;
         }
         VoronoiSample {
@@ -269,6 +284,18 @@ fn box_distance_sq(o: IVec3, lo: DVec3, hi: DVec3) -> f64 {
         _ => 0.0,
     };
     axis(o.x, lo.x, hi.x) + axis(o.y, lo.y, hi.y) + axis(o.z, lo.z, hi.z)
+}
+
+/// Squared distance from `local ∈ [0,1)³` to the box of the cell at any offset `o`.
+#[inline]
+fn far_box_distance_sq(o: IVec3, local: DVec3) -> f64 {
+    let axis = |o: i32, l: f64| match o {
+        o if o < 0 => f64::from(-o - 1) + l,
+        o if o > 0 => f64::from(o - 1) + (1.0 - l),
+        _ => 0.0,
+    };
+    let d = DVec3::new(axis(o.x, local.x), axis(o.y, local.y), axis(o.z, local.z));
+    d.length_squared()
 }
 
 /// Distance from `local` to the nearest point of the cells in shell `k` (Chebyshev radius `k`).
