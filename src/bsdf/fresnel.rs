@@ -88,7 +88,7 @@ pub fn schlick_dielectric(cos_i: f32, eta: f32) -> f32 {
     r0 + (1.0 - r0) * (1.0 - c).powi(5)
 }
 
-/// Lazányi & Szirmay-Kalos's approximation for metals (course ref. [23], WSCG 2005, eq. 6 without
+/// Lazányi & Szirmay-Kalos's approximation for metals (course ref. \[23\], WSCG 2005, eq. 6 without
 /// the fitted correction term): `((n−1)² + 4n(1−cos)^5 + k²) / ((n+1)² + k²)`.
 #[inline]
 pub fn lazanyi(cos_i: f32, n: f32, k: f32) -> f32 {

@@ -79,7 +79,7 @@ pub struct BrdfArgs {
     /// Random walks per evaluation for the Reference model (≥ 1).
     #[arg(long, default_value_t = ReferenceParams::default().samples)]
     pub walks: u32,
-    /// Viewing direction THETA_DEG[,PHI_DEG] from the normal (0 ≤ θ < 90).
+    /// Viewing direction `THETA_DEG[,PHI_DEG]` from the normal (0 ≤ θ < 90).
     #[arg(long, value_parser = parse_wo, default_value = "45,0", allow_hyphen_values = true)]
     pub wo: Wo,
     /// Read directions `x y z` (wi, local frame) from stdin; print `f_r f_g f_b pdf` per line.

@@ -1,5 +1,5 @@
 //! A gem recipe (`gems/*.ron`): the `materials` library, optional named `maps`, and the `surface`
-//! map tree; and its compilation into the runtime [`Surface`](crate::scene::Surface).
+//! map tree; and its compilation into the runtime [`Surface`].
 //!
 //! ```ron
 //! (
@@ -8,6 +8,29 @@
 //!     maps: { "tiles": Voronoi(...), ... },     // optional: sub-maps used as Map("tiles")
 //!     surface: Overlay(under: ..., over: ...),  // the tree (see `surface.rs`)
 //! )
+//! ```
+//!
+//! Compiling a recipe and looking up its surface:
+//!
+//! ```
+//! use lapidary::recipe::GemRecipe;
+//! let recipe = GemRecipe::parse("inline.ron", r#"(
+//!     materials: {
+//!         "body": (coats: [(ior: 1.58, roughness: 0.5)], base: Lambert(albedo: Gray(0.6))),
+//!         "flake": (base: Conductor(metal: Copper, roughness: 3.0)),
+//!     },
+//!     surface: Overlay(
+//!         under: Material("body"),
+//!         over: Voronoi(scale: 0.05, fill: 0.1, entries: [(1.0, Material("flake"))],
+//!                       bump: Beckmann(rms: 10.0)),
+//!     ),
+//! )"#)?;
+//! let surface = recipe.compile()?;
+//! let hit = surface.map.lookup(glam::Vec3::new(0.1, 0.2, 0.3), 0.5);
+//! let name = &surface.names[hit.material as usize];
+//! // Flakes carry a tilted facet normal; the body does not.
+//! assert_eq!(hit.facet.is_some(), name == "flake");
+//! # Ok::<(), lapidary::recipe::RecipeError>(())
 //! ```
 //!
 //! The recipe issue after the maps extends this with the stage, includes, the translucent body and

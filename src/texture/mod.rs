@@ -1,7 +1,7 @@
 //! Procedural solid textures over object-space positions (course §5.2.1; DESIGN §4).
 //!
 //! - [`voronoi`]: the exact, seedable cellular basis (F1, F2, edge distance, 64-bit cell ids).
-//! - [`perlin`]: hashed-lattice gradient noise, fBm and turbulence.
+//! - [`perlin`](mod@perlin): hashed-lattice gradient noise, fBm and turbulence.
 //! - [`field`]: scalar fields (Perlin, turbulence, marble, sums, products, remaps) in a flat table.
 //! - [`bump`]: the crystal-facet bump map (tilt distributions, the rule for facets seen from behind).
 //! - [`map`]: the runtime map tree — Voronoi surface and glitter maps, overlays, switches, material

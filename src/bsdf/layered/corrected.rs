@@ -1,7 +1,7 @@
 //! The Corrected model (the default) and the sampling mixture shared with the Course model.
 //!
 //! `f = f_top + T(wi)·T(wo)/η² · a · f_rest(wo', wi') + f_multi(wo, wi)` with `T(w) = 1 − E_top(w)`
-//! (the albedo coupling of Kelemen & Szirmay-Kalos, course ref. [20]) and the multiple-reflection
+//! (the albedo coupling of Kelemen & Szirmay-Kalos, course ref. \[20\]) and the multiple-reflection
 //! lobe `f_multi = M · q(wo) q(wi) / N`, `q(w) = T(w) · Q(cos θ')`, `M = ρ̄(1 − r_int)/(1 − ρ̄ r_int)`,
 //! `N = ∫ q cos θ dω`, where
 //! `Q(μ') = ∫ (1 − T_out(wi')) a f_rest cos θi' dωi'` is the energy the layers below send back up

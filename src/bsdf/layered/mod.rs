@@ -6,7 +6,7 @@
 //!   albedo-coupled transmission `T = 1 − E_top` and a multiple-internal-reflection lobe
 //!   ([`corrected`]).
 //! - [`Model::Reference`] — a position-free Monte Carlo random walk through the same stack
-//!   ([`reference`]), the yardstick for the other two.
+//!   ([`reference`](mod@reference)), the yardstick for the other two.
 //!
 //! Directions below the top coat are obtained by refracting through the **macro (shading) normal**
 //! ([`super::refract_macro`]), not through a sampled micro-normal. This is a deliberate choice: the

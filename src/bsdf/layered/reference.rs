@@ -3,7 +3,7 @@
 //! estimator structure of pbrt-v4's `LayeredBxDF`, generalised here to any number of coats by
 //! recursion: the "bottom" of coat `l` is the Reference walk of the stack below it).
 //!
-//! Each coat is a rough dielectric interface with transmission ([`RoughDielectric`], Walter et al.
+//! Each coat is a rough dielectric interface with transmission ([`RoughDielectric`](crate::bsdf::dielectric::RoughDielectric), Walter et al.
 //! 2007, sharing the distribution and V-cavity `G` of the analytic models), its varnish absorbs
 //! `exp(−α d / |cos θ|)` per traversal, and light bounces between the interface and the layers below
 //! until it leaves or Russian roulette ends it.
