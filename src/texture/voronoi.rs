@@ -200,7 +200,7 @@ impl Voronoi {
         // Edge: bisector distances, over shells around the F1 cell's neighbourhood while a shell
         // may hold a point closer than f1 + 2·edge.
         let mut edge = f64::INFINITY;
-        let mut bisector = |o: IVec3, edge: &mut f64| {
+        let bisector = |o: IVec3, edge: &mut f64| {
             let (q, c, _) = point(o);
             if c == c1 {
                 return;
