@@ -65,6 +65,14 @@ fn map_draws_the_shipped_gems_deterministically_on_any_thread_count() {
             .sum();
         assert!((total - 100.0).abs() < 0.1, "{gem}: {total}\n{report}");
         assert!(report.contains("glitter cells cover"), "{report}");
+        // The albedo preview draws the same pattern in other colours.
+        let c = dir.join("c.png");
+        let mut v = args(&c);
+        v.extend(["--colours".into(), "albedo".into()]);
+        let out = lapidary(&v.iter().map(String::as_str).collect::<Vec<_>>(), None);
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        assert_eq!(body(&text(&out.stdout)), body(&report));
+        assert_ne!(std::fs::read(&c).unwrap(), std::fs::read(&a).unwrap());
     }
 }
 

@@ -4,6 +4,7 @@
 //! light from the upper left. Stochastic switch bands show as dithering: every pixel draws its own
 //! random number from `(seed, pixel)`.
 
+use crate::bsdf::{Base, ConductorIor, StackDesc};
 use crate::recipe::GemRecipe;
 use crate::sampler::{hash_words, to_unit_f32};
 use crate::texture::MapHit;
@@ -84,6 +85,49 @@ pub struct MapArgs {
     /// Leave out the legend column.
     #[arg(long)]
     pub no_legend: bool,
+    /// How materials are coloured: `material` (a distinct flat colour each) or `albedo` (a rough
+    /// preview of each material's own colour at normal incidence).
+    #[arg(long, value_enum, default_value_t = Colours::Material)]
+    pub colours: Colours,
+}
+
+/// Colouring of `lapidary map`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Colours {
+    /// A distinct palette colour per material.
+    Material,
+    /// Each material's approximate colour: the base's albedo (a conductor's normal-incidence
+    /// reflectance `((n−1)² + k²)/((n+1)² + k²)`), times each coat's transmittance down and up,
+    /// `exp(−2·α·d)`, encoded as sRGB. Coat reflections and roughness are ignored: a preview only.
+    Albedo,
+}
+
+/// The `--colours albedo` preview colour of a stack (see [`Colours::Albedo`]).
+pub fn preview_colour(stack: &StackDesc) -> [u8; 3] {
+    let base = match &stack.base {
+        Base::Lambert { albedo } | Base::OrenNayar { albedo, .. } => *albedo,
+        Base::Conductor { ior, .. } => match ior {
+            ConductorIor::Complex { n, k } => n.zip(*k, |n, k| {
+                ((n - 1.0).powi(2) + k * k) / ((n + 1.0).powi(2) + k * k)
+            }),
+            ConductorIor::Perfect => crate::color::Spectrum::ONE,
+        },
+    };
+    let rgb = stack.coats.iter().fold(base, |c, coat| {
+        c.zip(coat.absorption, |c, a| {
+            c * (-2.0 * a * coat.thickness).exp()
+        })
+    });
+    let encode = |v: f32| {
+        let v = v.clamp(0.0, 1.0);
+        let s = if v <= 0.003_130_8 {
+            12.92 * v
+        } else {
+            1.055 * v.powf(1.0 / 2.4) - 0.055
+        };
+        (s * 255.0).round() as u8
+    };
+    rgb.0.map(encode)
 }
 
 /// Distinct colours: hues a golden angle apart, alternating saturation and value.
@@ -126,8 +170,20 @@ pub fn run(args: &MapArgs) -> Result<()> {
         })
         .collect();
     let mats = surface.names.len();
+    let colours: Vec<[u8; 3]> = (0..mats)
+        .map(|i| match args.colours {
+            Colours::Material => palette(i),
+            Colours::Albedo => preview_colour(&surface.stacks[i]),
+        })
+        .collect();
     let mut count = vec![0usize; mats];
     let light = Vec3::new(-0.5, 0.5, 1.0).normalize();
+    // Outlines in black, or in white where the materials are dark (albedo previews).
+    let outline_colour = if args.colours == Colours::Albedo {
+        [255, 255, 255]
+    } else {
+        [20, 20, 20]
+    };
     let legend_w = if args.no_legend { 0 } else { 300 };
     let (w, h) = (n + legend_w, n.max(40 + 22 * mats));
     let mut buf = vec![255u8; w * h * 3];
@@ -148,19 +204,19 @@ pub fn run(args: &MapArgs) -> Result<()> {
                             && hits[yy as usize * n + xx as usize].trail.glitter_cell() != g
                     });
             let rgb = if outline {
-                [20, 20, 20]
+                outline_colour
             } else {
                 let shade = hit
                     .facet
                     .map_or(1.0, |f| (f.dot(light) / light.z).clamp(0.3, 1.6));
-                palette(hit.material as usize).map(|c| (f32::from(c) * shade).min(255.0) as u8)
+                colours[hit.material as usize].map(|c| (f32::from(c) * shade).min(255.0) as u8)
             };
             let o = (y * w + x) * 3;
             buf[o..o + 3].copy_from_slice(&rgb);
         }
     }
     if !args.no_legend {
-        draw_legend(&mut buf, (w, h), n, &surface.names, &count)?;
+        draw_legend(&mut buf, (w, h), n, &surface.names, &colours, &count)?;
     }
     let img = image::RgbImage::from_raw(w as u32, h as u32, buf)
         .ok_or_else(|| anyhow!("map: buffer size"))?;
@@ -200,6 +256,7 @@ fn draw_legend(
     (w, h): (usize, usize),
     left: usize,
     names: &[String],
+    colours: &[[u8; 3]],
     count: &[usize],
 ) -> Result<()> {
     super::plot::register_font();
@@ -210,7 +267,7 @@ fn draw_legend(
     let x0 = left as i32 + 14;
     for (i, name) in names.iter().enumerate() {
         let y = 20 + 22 * i as i32;
-        let [r, g, b] = palette(i);
+        let [r, g, b] = colours[i];
         root.draw(&Rectangle::new(
             [(x0, y), (x0 + 16, y + 16)],
             RGBColor(r, g, b).filled(),
@@ -245,6 +302,40 @@ mod tests {
             assert!(parse_plane(bad).is_err(), "{bad}");
         }
         assert!(parse_extent("0").is_err() && parse_extent("2").is_ok());
+    }
+
+    #[test]
+    fn preview_colours_follow_base_and_tint() {
+        use crate::bsdf::Coat;
+        use crate::color::Spectrum;
+        let white = StackDesc::new(
+            vec![],
+            Base::Lambert {
+                albedo: Spectrum::ONE,
+            },
+        );
+        assert_eq!(preview_colour(&white), [255, 255, 255]);
+        let tinted = StackDesc::new(
+            vec![Coat {
+                ior: 1.5,
+                roughness: 1.0,
+                absorption: Spectrum::rgb(0.0, 0.5, 2.0),
+                thickness: 1.0,
+            }],
+            Base::Lambert {
+                albedo: Spectrum::splat(0.5),
+            },
+        );
+        let [r, g, b] = preview_colour(&tinted);
+        assert!(r > g && g > b, "{r} {g} {b}");
+        let silver = StackDesc::new(
+            vec![],
+            Base::Conductor {
+                ior: ConductorIor::Perfect,
+                roughness: 1.0,
+            },
+        );
+        assert_eq!(preview_colour(&silver), [255, 255, 255]);
     }
 
     #[test]
