@@ -77,13 +77,7 @@ pub struct GemRecipe {
 impl GemRecipe {
     /// Reads and parses a recipe file (materials are validated, the tree is not yet compiled).
     pub fn load(path: &Path) -> Result<Self, RecipeError> {
-        let file = path.display().to_string();
-        let source = std::fs::read_to_string(path).map_err(|e| RecipeError {
-            file: file.clone(),
-            line: 0,
-            col: 0,
-            message: format!("cannot read the file: {e}"),
-        })?;
+        let (file, source) = super::read_source(path)?;
         Self::parse(&file, &source)
     }
 

@@ -69,13 +69,7 @@ pub struct MaterialLibrary {
 impl MaterialLibrary {
     /// Reads and parses a library file.
     pub fn load(path: &Path) -> Result<Self, RecipeError> {
-        let file = path.display().to_string();
-        let source = std::fs::read_to_string(path).map_err(|e| RecipeError {
-            file: file.clone(),
-            line: 0,
-            col: 0,
-            message: format!("cannot read the file: {e}"),
-        })?;
+        let (file, source) = read_source(path)?;
         Self::parse(&file, &source)
     }
 
@@ -170,6 +164,18 @@ impl MaterialLibrary {
             message: format!("material \"{name}\": {message}"),
         }
     }
+}
+
+/// Reads a description file: its name for messages and its text, or an error naming the file.
+pub fn read_source(path: &Path) -> Result<(String, String), RecipeError> {
+    let file = path.display().to_string();
+    let source = std::fs::read_to_string(path).map_err(|e| RecipeError {
+        file: file.clone(),
+        line: 0,
+        col: 0,
+        message: format!("cannot read the file: {e}"),
+    })?;
+    Ok((file, source))
 }
 
 /// RON options shared by every description file: optional fields are written without `Some(..)`,
