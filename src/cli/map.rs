@@ -152,7 +152,7 @@ pub fn palette(i: usize) -> [u8; 3] {
 /// Runs `lapidary map`.
 pub fn run(args: &MapArgs) -> Result<()> {
     let recipe = GemRecipe::load(&args.recipe).map_err(|e| anyhow!("{e}"))?;
-    let surface = recipe.compile().map_err(|e| anyhow!("{e}"))?;
+    let surface = recipe.compile().map_err(|e| anyhow!("{e}"))?.surface;
     for name in surface.unused() {
         eprintln!("warning: material \"{name}\" is never used by the surface map");
     }

@@ -1,12 +1,14 @@
-//! A gem recipe (`gems/*.ron`): the `materials` library, optional named `maps`, and the `surface`
-//! map tree; and its compilation into the runtime [`Surface`].
+//! A gem recipe (`gems/*.ron`): materials (own and included), optional named `maps`, the
+//! `surface` map tree, an optional `stage`; and its compilation into a runtime [`Scene`].
 //!
 //! ```ron
 //! (
 //!     seed: 0,                                  // optional: re-rolls every default seed
+//!     include: ["../materials/course.ron"],     // optional: material libraries
 //!     materials: { "name": (coats: [...], base: ...), ... },
 //!     maps: { "tiles": Voronoi(...), ... },     // optional: sub-maps used as Map("tiles")
 //!     surface: Overlay(under: ..., over: ...),  // the tree (see `surface.rs`)
+//!     stage: (camera: ..., render: (...)),      // optional: replaces parts of the studio stage
 //! )
 //! ```
 //!
@@ -14,6 +16,7 @@
 //!
 //! ```
 //! use lapidary::recipe::GemRecipe;
+//! use lapidary::scene::Effect;
 //! let recipe = GemRecipe::parse("inline.ron", r#"(
 //!     materials: {
 //!         "body": (coats: [(ior: 1.58, roughness: 0.5)], base: Lambert(albedo: Gray(0.6))),
@@ -25,29 +28,25 @@
 //!                       bump: Beckmann(rms: 10.0)),
 //!     ),
 //! )"#)?;
-//! let surface = recipe.compile()?;
-//! let hit = surface.map.lookup(glam::Vec3::new(0.1, 0.2, 0.3), 0.5);
-//! let name = &surface.names[hit.material as usize];
+//! let scene = recipe.compile()?;
+//! let hit = scene.surface.map.lookup(glam::Vec3::new(0.1, 0.2, 0.3), 0.5);
+//! let name = &scene.surface.names[hit.material as usize];
 //! // Flakes carry a tilted facet normal; the body does not.
 //! assert_eq!(hit.facet.is_some(), name == "flake");
+//! // The scene turns on what it uses, and nothing else.
+//! assert!(scene.effects.on(Effect::FacetBump) && !scene.effects.on(Effect::Absorption));
 //! # Ok::<(), lapidary::recipe::RecipeError>(())
 //! ```
-//!
-//! The recipe issue after the maps extends this with the stage, includes, the translucent body and
-//! the effects set; the fields here keep their meaning.
 
-use super::surface::{BumpDesc, FieldDesc, MapDesc, SwitchDesc};
-use super::{MaterialDesc, MaterialFile, MaterialLibrary, RecipeError, did_you_mean, ron_options};
-use crate::sampler::hash_words;
-use crate::scene::Surface;
-use crate::texture::{
-    Entry, FacetBump, FieldId, FieldNode, FieldTable, Map, MapNode, NodeId, Octaves, Stop, Tilt,
-    Voronoi, VoronoiNode,
-};
-use glam::Vec3;
+use super::compile::Compiler;
+use super::source::Source;
+use super::stage::StageDesc;
+use super::surface::MapDesc;
+use super::{MaterialDesc, MaterialLibrary, RecipeError, ron_options};
+use crate::scene::Scene;
 use indexmap::IndexMap;
 use serde::{Deserialize, Serialize};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// What a gem recipe file holds.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -56,368 +55,166 @@ pub struct GemDesc {
     /// Recipe seed (default 0): every default Voronoi and noise seed derives from it.
     #[serde(default)]
     pub seed: u64,
-    /// Layered materials by name, in file order (their index is the material id).
+    /// Material libraries whose materials the tree may use, relative to this file.
+    #[serde(default)]
+    pub include: Vec<String>,
+    /// The recipe's own layered materials by name, in file order.
+    #[serde(default)]
     pub materials: IndexMap<String, MaterialDesc>,
     /// Named sub-maps, usable as `Map("name")` anywhere in the tree.
     #[serde(default)]
     pub maps: IndexMap<String, MapDesc>,
     /// The surface map tree.
     pub surface: MapDesc,
+    /// Parts of the studio stage to replace.
+    #[serde(default)]
+    pub stage: Option<StageDesc>,
 }
 
-/// A parsed gem recipe with its source text (for error positions).
+/// A parsed gem recipe with its source text (for error positions) and its resolved materials.
 #[derive(Clone, Debug)]
 pub struct GemRecipe {
-    file: String,
-    source: String,
+    pub(crate) source: Source,
+    pub(crate) path: Option<PathBuf>,
     /// The parsed content.
     pub content: GemDesc,
+    /// Own and included materials.
+    pub library: MaterialLibrary,
+}
+
+/// Everything `lapidary check` learns about a file: every error found, warnings, and the compiled
+/// scene when there were no errors.
+#[derive(Debug, Default)]
+pub struct Report {
+    /// Errors, in the order found.
+    pub errors: Vec<RecipeError>,
+    /// Things that are allowed but probably unintended (unused materials).
+    pub warnings: Vec<RecipeError>,
+    /// The compiled scene (when `errors` is empty).
+    pub scene: Option<Scene>,
 }
 
 impl GemRecipe {
-    /// Reads and parses a recipe file (materials are validated, the tree is not yet compiled).
+    /// Reads and parses a recipe file and its includes (materials validated, tree not yet
+    /// compiled); the first error, if any.
     pub fn load(path: &Path) -> Result<Self, RecipeError> {
-        let (file, source) = super::read_source(path)?;
-        Self::parse(&file, &source)
+        let source = Source::read(path)?;
+        first_error(Self::read(source, Some(path)))
     }
 
-    /// Parses recipe text; `file` is used in messages.
-    pub fn parse(file: &str, source: &str) -> Result<Self, RecipeError> {
-        let content: GemDesc = ron_options().from_str(source).map_err(|e| RecipeError {
-            file: file.to_string(),
-            line: e.span.start.line,
-            col: e.span.start.col,
-            message: e.code.to_string(),
-        })?;
-        let recipe = GemRecipe {
-            file: file.to_string(),
-            source: source.to_string(),
-            content,
+    /// Parses recipe text; `file` is used in messages and as the base of relative paths.
+    pub fn parse(file: &str, text: &str) -> Result<Self, RecipeError> {
+        first_error(Self::read(Source::new(file, text), Some(Path::new(file))))
+    }
+
+    /// Parses and resolves includes, collecting every error.
+    fn read(source: Source, path: Option<&Path>) -> (Option<Self>, Vec<RecipeError>) {
+        let mut errors = vec![];
+        let content: GemDesc = match ron_options().from_str(&source.text) {
+            Ok(c) => c,
+            Err(e) => return (None, vec![source.ron_error(&e)]),
         };
-        recipe.library()?;
-        Ok(recipe)
+        let library = MaterialLibrary::assemble(
+            source.clone(),
+            path,
+            content.include.clone(),
+            content.materials.clone(),
+            &mut errors,
+        );
+        library.check_all(&mut errors);
+        let recipe = GemRecipe {
+            source,
+            path: path.map(Path::to_path_buf),
+            content,
+            library,
+        };
+        (Some(recipe), errors)
+    }
+
+    /// Checks a file completely: syntax, includes, every material, the whole tree, the stage;
+    /// reports every error it can find (the parser stops at its first error; everything after
+    /// parsing is checked in full).
+    pub fn check(path: &Path) -> Report {
+        match Source::read(path) {
+            Ok(source) => Self::check_source(source, Some(path)),
+            Err(e) => Report {
+                errors: vec![e],
+                ..Report::default()
+            },
+        }
+    }
+
+    /// [`GemRecipe::check`] over text already in memory.
+    pub fn check_source(source: Source, path: Option<&Path>) -> Report {
+        let (recipe, mut errors) = Self::read(source, path);
+        let Some(recipe) = recipe else {
+            return Report {
+                errors,
+                ..Report::default()
+            };
+        };
+        let mut warnings = vec![];
+        let scene = recipe.compile_into(&mut errors, &mut warnings);
+        Report {
+            scene: if errors.is_empty() { scene } else { None },
+            errors,
+            warnings,
+        }
     }
 
     /// The file name used in messages.
     pub fn file(&self) -> &str {
-        &self.file
+        &self.source.file
     }
 
-    /// The recipe's materials as a library (validated, with positions for errors).
-    pub fn library(&self) -> Result<MaterialLibrary, RecipeError> {
-        let lib = MaterialLibrary::from_parts(
-            &self.file,
-            &self.source,
-            MaterialFile {
-                materials: self.content.materials.clone(),
-            },
-        );
-        for name in lib.names() {
-            lib.stack(name)?;
-        }
-        Ok(lib)
+    /// The directory relative paths (includes, meshes, environment maps) start from.
+    pub fn base_dir(&self) -> PathBuf {
+        self.path
+            .as_deref()
+            .and_then(Path::parent)
+            .map(Path::to_path_buf)
+            .unwrap_or_default()
     }
 
-    /// Compiles materials and map tree into the runtime surface.
-    pub fn compile(&self) -> Result<Surface, RecipeError> {
-        let lib = self.library()?;
-        let names: Vec<String> = lib.names().map(str::to_string).collect();
-        let stacks = names
-            .iter()
-            .map(|n| lib.stack(n))
-            .collect::<Result<Vec<_>, _>>()?;
-        let mut c = Compiler {
-            recipe: self,
-            nodes: vec![],
-            entries: vec![],
-            stops: vec![],
-            fields: FieldTable::default(),
-            named: IndexMap::new(),
-            counter: 0,
-            used: vec![false; names.len()],
-        };
-        let root = c.node(&self.content.surface)?;
-        let used = c.used.clone();
-        let map = Map::new(c.nodes, c.entries, c.stops, c.fields, root).map_err(|e| {
-            let (line, col) = self.find(&["surface"]);
-            self.error(line, col, format!("surface: {e}"))
-        })?;
-        Ok(Surface {
-            names,
-            stacks,
-            map,
-            used,
-        })
-    }
-
-    fn error(&self, line: usize, col: usize, message: String) -> RecipeError {
-        RecipeError {
-            file: self.file.clone(),
-            line,
-            col,
-            message,
+    /// Compiles materials, map tree, stage and effects into a runtime scene; the first error.
+    pub fn compile(&self) -> Result<Scene, RecipeError> {
+        let mut errors = vec![];
+        let scene = self.compile_into(&mut errors, &mut vec![]);
+        match errors.into_iter().next() {
+            Some(e) => Err(e),
+            None => Ok(scene.expect("no errors means a scene")),
         }
     }
 
-    /// Position of the first occurrence of the token sequence `parts` (each separated by optional
-    /// whitespace), e.g. `["Material", "(", "\"x\""]`; `(0, 0)` if absent.
-    fn find(&self, parts: &[&str]) -> (usize, usize) {
-        let src = &self.source;
-        let mut start = 0;
-        while let Some(off) = src[start..].find(parts[0]) {
-            let at = start + off;
-            let mut pos = at + parts[0].len();
-            let ok = parts[1..].iter().all(|p| {
-                let rest = &src[pos..];
-                let trimmed = rest.trim_start();
-                pos += rest.len() - trimmed.len();
-                if trimmed.starts_with(p) {
-                    pos += p.len();
-                    true
-                } else {
-                    false
-                }
-            });
-            if ok {
-                return super::line_col(src, at);
+    fn compile_into(
+        &self,
+        errors: &mut Vec<RecipeError>,
+        warnings: &mut Vec<RecipeError>,
+    ) -> Option<Scene> {
+        let scene = Compiler::new(self).run(errors);
+        if let Some(scene) = &scene {
+            for name in scene.surface.unused() {
+                warnings.push(self.source.error(
+                    self.source.key(name),
+                    format!("material \"{name}\" is defined but the surface never uses it"),
+                ));
             }
-            start = at + parts[0].len();
         }
-        (0, 0)
+        scene
     }
 }
 
-/// Compilation state: the flat runtime arrays being filled, children before parents.
-struct Compiler<'a> {
-    recipe: &'a GemRecipe,
-    nodes: Vec<MapNode>,
-    entries: Vec<Entry>,
-    stops: Vec<Stop>,
-    fields: FieldTable,
-    /// Named maps: `None` while being compiled (to catch cycles), then their node.
-    named: IndexMap<String, Option<NodeId>>,
-    /// Running count of seeded nodes, for default seeds.
-    counter: u64,
-    used: Vec<bool>,
-}
-
-impl Compiler<'_> {
-    fn push(&mut self, node: MapNode) -> NodeId {
-        self.nodes.push(node);
-        (self.nodes.len() - 1) as NodeId
-    }
-
-    /// The seed of the next seeded node: the explicit one, or one derived from its position.
-    fn seed(&mut self, explicit: Option<u64>) -> u64 {
-        self.counter += 1;
-        match explicit {
-            Some(s) => hash_words(&[self.recipe.content.seed, 0x5eed, s]),
-            None => hash_words(&[self.recipe.content.seed, 0xdef, self.counter]),
-        }
-    }
-
-    fn node(&mut self, desc: &MapDesc) -> Result<NodeId, RecipeError> {
-        let r = self.recipe;
-        match desc {
-            MapDesc::Material(name) => match r.content.materials.get_index_of(name) {
-                Some(i) => {
-                    self.used[i] = true;
-                    Ok(self.push(MapNode::Material(i as u32)))
-                }
-                None => {
-                    let (line, col) = r.find(&["Material", "(", &format!("\"{name}\"")]);
-                    let hint = did_you_mean(name, r.content.materials.keys().map(String::as_str))
-                        .map(|s| format!(" (did you mean \"{s}\"?)"))
-                        .unwrap_or_default();
-                    Err(r.error(
-                        line,
-                        col,
-                        format!(
-                            "unknown material \"{name}\"{hint}; `materials` defines: {}",
-                            r.content
-                                .materials
-                                .keys()
-                                .cloned()
-                                .collect::<Vec<_>>()
-                                .join(", ")
-                        ),
-                    ))
-                }
-            },
-            MapDesc::Map(name) => {
-                let (line, col) = r.find(&["Map", "(", &format!("\"{name}\"")]);
-                match self.named.get(name) {
-                    Some(Some(id)) => return Ok(*id),
-                    Some(None) => {
-                        return Err(r.error(
-                            line,
-                            col,
-                            format!("map \"{name}\" contains itself (a cycle through `maps`)"),
-                        ));
-                    }
-                    None => {}
-                }
-                let Some(sub) = r.content.maps.get(name) else {
-                    let hint = did_you_mean(name, r.content.maps.keys().map(String::as_str))
-                        .map(|s| format!(" (did you mean \"{s}\"?)"))
-                        .unwrap_or_default();
-                    return Err(r.error(line, col, format!("unknown map \"{name}\"{hint}")));
-                };
-                self.named.insert(name.clone(), None);
-                let id = self.node(sub)?;
-                self.named.insert(name.clone(), Some(id));
-                Ok(id)
-            }
-            MapDesc::Voronoi {
-                scale,
-                jitter,
-                seed,
-                entries,
-                fill,
-                bump,
-            } => {
-                let seed = self.seed(*seed);
-                let children = entries
-                    .iter()
-                    .map(|(w, d)| Ok((w.0, self.node(d)?)))
-                    .collect::<Result<Vec<_>, RecipeError>>()?;
-                let total: f64 = children.iter().map(|(w, _)| f64::from(*w)).sum();
-                let first = self.entries.len() as u32;
-                let mut run = 0.0f64;
-                for (k, (w, node)) in children.iter().enumerate() {
-                    run += f64::from(*w);
-                    let cumulative = if k + 1 == children.len() {
-                        1.0
-                    } else {
-                        (run / total) as f32
-                    };
-                    self.entries.push(Entry {
-                        cumulative,
-                        node: *node,
-                    });
-                }
-                let bump = bump.as_ref().map(|b| FacetBump {
-                    tilt: match *b {
-                        BumpDesc::Cone { half_angle } => Tilt::Cone { half_angle },
-                        BumpDesc::Beckmann { rms } => Tilt::Beckmann { rms },
-                    },
-                });
-                Ok(self.push(MapNode::Voronoi(VoronoiNode {
-                    basis: Voronoi::new(seed, *jitter),
-                    inv_scale: 1.0 / scale,
-                    first,
-                    count: children.len() as u32,
-                    fill: *fill,
-                    bump,
-                })))
-            }
-            MapDesc::Overlay { under, over } => {
-                let under = self.node(under)?;
-                let over = self.node(over)?;
-                Ok(self.push(MapNode::Overlay { under, over }))
-            }
-            MapDesc::Switch(SwitchDesc(s)) => {
-                let field = self.field(&s.by)?;
-                let children = s
-                    .stops
-                    .iter()
-                    .map(|(t, d)| Ok((*t, self.node(d)?)))
-                    .collect::<Result<Vec<_>, RecipeError>>()?;
-                let first = self.stops.len() as u32;
-                self.stops.extend(
-                    children
-                        .iter()
-                        .map(|&(threshold, node)| Stop { threshold, node }),
-                );
-                Ok(self.push(MapNode::Switch {
-                    field,
-                    first,
-                    count: children.len() as u32,
-                    blend: s.blend,
-                }))
-            }
-        }
-    }
-
-    fn field(&mut self, desc: &FieldDesc) -> Result<FieldId, RecipeError> {
-        let octaves = |this: &mut Self, n: u32, gain: f32, lacunarity: f32, seed: Option<u64>| {
-            let s = this.seed(seed);
-            Octaves {
-                octaves: n,
-                gain,
-                lacunarity,
-                seed: (s ^ (s >> 32)) as u32,
-            }
-        };
-        let node = match desc {
-            FieldDesc::Constant(c) => FieldNode::Constant(*c),
-            FieldDesc::Perlin {
-                scale,
-                octaves: n,
-                gain,
-                lacunarity,
-                seed,
-            } => FieldNode::Fbm {
-                inv_scale: 1.0 / scale,
-                octaves: octaves(self, *n, *gain, *lacunarity, *seed),
-            },
-            FieldDesc::Turbulence {
-                scale,
-                octaves: n,
-                gain,
-                lacunarity,
-                seed,
-            } => FieldNode::Turbulence {
-                inv_scale: 1.0 / scale,
-                octaves: octaves(self, *n, *gain, *lacunarity, *seed),
-            },
-            FieldDesc::Marble {
-                scale,
-                axis,
-                turbulence,
-                octaves: n,
-                gain,
-                lacunarity,
-                seed,
-            } => FieldNode::Marble {
-                inv_scale: 1.0 / scale,
-                axis: Vec3::new(axis.0, axis.1, axis.2).normalize(),
-                turbulence: *turbulence,
-                octaves: octaves(self, *n, *gain, *lacunarity, *seed),
-            },
-            FieldDesc::Sum(list) | FieldDesc::Product(list) => {
-                let ids = list
-                    .iter()
-                    .map(|f| self.field(f))
-                    .collect::<Result<Vec<_>, _>>()?;
-                let (first, count) = self.fields.add_args(&ids);
-                if matches!(desc, FieldDesc::Sum(_)) {
-                    FieldNode::Sum { first, count }
-                } else {
-                    FieldNode::Product { first, count }
-                }
-            }
-            FieldDesc::Remap {
-                field,
-                from,
-                to,
-                clamp,
-            } => FieldNode::Remap {
-                input: self.field(field)?,
-                from: [from.0, from.1],
-                to: [to.0, to.1],
-                clamp: *clamp,
-            },
-        };
-        self.fields
-            .add(node)
-            .map_err(|e| self.recipe.error(0, 0, format!("internal: {e}")))
+fn first_error<T>((value, errors): (Option<T>, Vec<RecipeError>)) -> Result<T, RecipeError> {
+    match errors.into_iter().next() {
+        Some(e) => Err(e),
+        None => Ok(value.expect("no errors means a value")),
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glam::Vec3;
 
     fn gem(name: &str) -> GemRecipe {
         let path = Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -429,7 +226,7 @@ mod tests {
     #[test]
     fn shipped_gems_compile_and_use_every_material() {
         for (name, materials, depth) in [("lepidolite.ron", 20, 3), ("sunstone.ron", 5, 1)] {
-            let s = gem(name).compile().unwrap_or_else(|e| panic!("{e}"));
+            let s = gem(name).compile().unwrap_or_else(|e| panic!("{e}")).surface;
             assert_eq!(s.names.len(), materials, "{name}");
             assert_eq!(
                 s.unused().count(),
@@ -518,9 +315,9 @@ mod tests {
                 "(seed: {seed}, {MATS}\n surface: Voronoi(scale: 0.1, entries: [(1.0, Material(\"a\")), (1.0, Material(\"b\"))]))"
             )
         };
-        let a = GemRecipe::parse("g", &src(0)).unwrap().compile().unwrap();
-        let b = GemRecipe::parse("g", &src(1)).unwrap().compile().unwrap();
-        let a2 = GemRecipe::parse("g", &src(0)).unwrap().compile().unwrap();
+        let a = GemRecipe::parse("g", &src(0)).unwrap().compile().unwrap().surface;
+        let b = GemRecipe::parse("g", &src(1)).unwrap().compile().unwrap().surface;
+        let a2 = GemRecipe::parse("g", &src(0)).unwrap().compile().unwrap().surface;
         let mut differ = 0;
         for i in 0..200 {
             let p = Vec3::new(i as f32 * 0.137, 0.3, -0.2);

@@ -21,37 +21,6 @@
 
 use serde::{Deserialize, Deserializer, Serialize};
 
-/// Declares a deserializer for an `f32` field that rejects values outside `lo ..= hi` (or, with
-/// `open`, `lo <.. hi`), naming the field and the range.
-macro_rules! ranged {
-    ($fn:ident, $name:literal, $lo:expr, $hi:expr) => {
-        fn $fn<'de, D: Deserializer<'de>>(d: D) -> Result<f32, D::Error> {
-            let v = f32::deserialize(d)?;
-            if (($lo)..=($hi)).contains(&v) {
-                Ok(v)
-            } else {
-                Err(serde::de::Error::custom(format!(
-                    "{} = {v} is out of range: allowed {} ..= {}",
-                    $name, $lo, $hi
-                )))
-            }
-        }
-    };
-    ($fn:ident, $name:literal, open $lo:expr, $hi:expr) => {
-        fn $fn<'de, D: Deserializer<'de>>(d: D) -> Result<f32, D::Error> {
-            let v = f32::deserialize(d)?;
-            if v > $lo && v <= $hi {
-                Ok(v)
-            } else {
-                Err(serde::de::Error::custom(format!(
-                    "{} = {v} is out of range: allowed {} <.. {}",
-                    $name, $lo, $hi
-                )))
-            }
-        }
-    };
-}
-
 ranged!(scale_range, "scale", 1e-4, 1e4);
 ranged!(jitter_range, "jitter", 0.0, 1.0);
 ranged!(fill_range, "fill", 0.0, 1.0);

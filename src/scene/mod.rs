@@ -1,30 +1,27 @@
-//! Runtime scene data compiled from a recipe: flat arrays indexed by integers, no names or maps on
-//! the hot path. Today: the gem's [`Surface`] (materials and map tree); the stage, lights and the
-//! effects set join it with the recipe and renderer issues.
+//! Runtime scene data compiled from a recipe (DESIGN §5): flat arrays indexed by integers, no
+//! names or hash maps on the hot path, kept apart from the serde description in [`crate::recipe`].
+//!
+//! A [`Scene`] is the gem's [`Surface`] (material table and map tree), the resolved [`Stage`]
+//! (shape, placement, ground, environment, lights, camera, render settings) and the [`Effects`] set:
+//! which optional parts of the simulation the scene calls for, and why.
 
-use crate::bsdf::StackDesc;
-use crate::texture::Map;
+pub mod effects;
+pub mod stage;
+pub mod surface;
 
-/// A gem's compiled surface.
-#[derive(Clone, Debug)]
-pub struct Surface {
-    /// Material names, by material index (recipe order).
-    pub names: Vec<String>,
-    /// Layered stacks, by material index (tables are built by the renderer).
-    pub stacks: Vec<StackDesc>,
-    /// The map tree; its leaves are indices into `names`/`stacks`.
-    pub map: Map,
-    /// Whether the tree uses each material.
-    pub used: Vec<bool>,
-}
+pub use effects::{Effect, Effects};
+pub use stage::Stage;
+pub use surface::Surface;
 
-impl Surface {
-    /// Names of materials the tree never uses.
-    pub fn unused(&self) -> impl Iterator<Item = &str> {
-        self.names
-            .iter()
-            .zip(&self.used)
-            .filter(|(_, u)| !**u)
-            .map(|(n, _)| n.as_str())
-    }
+/// A compiled recipe, ready to render.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scene {
+    /// Materials and map tree.
+    pub surface: Surface,
+    /// Shape, lights, camera, render settings.
+    pub stage: Stage,
+    /// The effects the scene calls for.
+    pub effects: Effects,
+    /// Hash of the recipe's text and included files (for render metadata).
+    pub hash: u64,
 }

@@ -34,6 +34,10 @@ pub type NodeId = u32;
 /// Most Voronoi cells one lookup may visit; deeper trees are rejected by [`Map::new`].
 pub const MAX_TRAIL: usize = 16;
 
+/// Deepest nesting of nodes (a chain of maps inside maps) a lookup may walk; deeper trees are
+/// rejected by [`Map::new`], so a lookup's recursion stays shallow.
+pub const MAX_DEPTH: usize = 64;
+
 /// One node of the tree.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum MapNode {
@@ -167,6 +171,16 @@ pub enum MapError {
     /// Too many nested Voronoi maps on one path.
     #[error("a lookup could visit {0} Voronoi maps; at most {MAX_TRAIL} are allowed")]
     TooDeep(usize),
+    /// Nodes nested too deeply to evaluate.
+    #[error("maps nest {0} levels deep; at most {MAX_DEPTH} can be evaluated")]
+    TooDeeplyNested(usize),
+}
+
+#[derive(Clone, Copy, Debug)]
+struct NodeFacts {
+    transparent: bool,
+    trail: usize,
+    depth: usize,
 }
 
 /// A compiled map tree.
@@ -253,54 +267,93 @@ impl Map {
             fields,
             root,
         };
-        if map.may_be_transparent(root) {
+        let facts = map.analyse(root)[root as usize];
+        if facts.depth > MAX_DEPTH {
+            return Err(MapError::TooDeeplyNested(facts.depth));
+        }
+        if facts.transparent {
             return Err(MapError::Transparent);
         }
-        let depth = map.max_trail(root);
-        if depth > MAX_TRAIL {
-            return Err(MapError::TooDeep(depth));
+        if facts.trail > MAX_TRAIL {
+            return Err(MapError::TooDeep(facts.trail));
         }
         Ok(map)
     }
 
-    fn children(&self, node: NodeId) -> Vec<NodeId> {
-        match self.nodes[node as usize] {
-            MapNode::Material(_) => vec![],
-            MapNode::Voronoi(v) => self.entries[v.first as usize..(v.first + v.count) as usize]
-                .iter()
-                .map(|e| e.node)
-                .collect(),
-            MapNode::Overlay { under, over } => vec![over, under],
-            MapNode::Switch { first, count, .. } => self.stops
-                [first as usize..(first + count) as usize]
-                .iter()
-                .map(|s| s.node)
-                .collect(),
+    /// The children of `node`.
+    fn children(&self, node: NodeId) -> impl Iterator<Item = NodeId> + '_ {
+        let (entries, stops, pair): (&[Entry], &[Stop], [Option<NodeId>; 2]) =
+            match self.nodes[node as usize] {
+                MapNode::Material(_) => (&[], &[], [None, None]),
+                MapNode::Voronoi(v) => (
+                    &self.entries[v.first as usize..(v.first + v.count) as usize],
+                    &[],
+                    [None, None],
+                ),
+                MapNode::Overlay { under, over } => (&[], &[], [Some(over), Some(under)]),
+                MapNode::Switch { first, count, .. } => (
+                    &[],
+                    &self.stops[first as usize..(first + count) as usize],
+                    [None, None],
+                ),
+            };
+        entries
+            .iter()
+            .map(|e| e.node)
+            .chain(stops.iter().map(|s| s.node))
+            .chain(pair.into_iter().flatten())
+    }
+
+    /// Per node, in one pass over the children-before-parents array (linear even when named maps
+    /// make the tree a DAG): whether it can be transparent, the most Voronoi cells a lookup below
+    /// it visits, and the longest chain of nodes below it (itself included).
+    fn analyse(&self, upto: NodeId) -> Vec<NodeFacts> {
+        let mut facts: Vec<NodeFacts> = Vec::with_capacity(upto as usize + 1);
+        for i in 0..=upto {
+            let kids: Vec<NodeFacts> = self.children(i).map(|c| facts[c as usize]).collect();
+            let depth = 1 + kids.iter().map(|k| k.depth).max().unwrap_or(0);
+            let any_transparent = kids.iter().any(|k| k.transparent);
+            let f = match self.nodes[i as usize] {
+                MapNode::Material(_) => NodeFacts {
+                    transparent: false,
+                    trail: 0,
+                    depth,
+                },
+                MapNode::Voronoi(v) => NodeFacts {
+                    transparent: v.fill < 1.0 || any_transparent,
+                    trail: 1 + kids.iter().map(|k| k.trail).max().unwrap_or(0),
+                    depth,
+                },
+                // Children order: over, under.
+                MapNode::Overlay { .. } => NodeFacts {
+                    transparent: kids[1].transparent,
+                    trail: kids[0].trail.saturating_add(kids[1].trail),
+                    depth,
+                },
+                MapNode::Switch { .. } => NodeFacts {
+                    transparent: any_transparent,
+                    trail: kids.iter().map(|k| k.trail).max().unwrap_or(0),
+                    depth,
+                },
+            };
+            facts.push(f);
         }
+        facts
     }
 
     /// Whether some point can come out transparent below `node`.
     pub fn may_be_transparent(&self, node: NodeId) -> bool {
-        match self.nodes[node as usize] {
-            MapNode::Material(_) => false,
-            MapNode::Voronoi(v) if v.fill < 1.0 => true,
-            MapNode::Overlay { under, .. } => self.may_be_transparent(under),
-            _ => self
-                .children(node)
-                .iter()
-                .any(|&c| self.may_be_transparent(c)),
-        }
+        self.analyse(node)[node as usize].transparent
     }
 
     /// The most Voronoi cells a lookup below `node` can visit.
     pub fn max_trail(&self, node: NodeId) -> usize {
-        let kids = self.children(node).into_iter().map(|c| self.max_trail(c));
-        match self.nodes[node as usize] {
-            MapNode::Material(_) => 0,
-            MapNode::Voronoi(_) => 1 + kids.max().unwrap_or(0),
-            MapNode::Overlay { .. } => kids.sum(),
-            MapNode::Switch { .. } => kids.max().unwrap_or(0),
-        }
+        self.analyse(node)[node as usize].trail
+    }
+
+    /// The longest chain of nested nodes below `node`, itself included.
+    pub fn depth(&self, node: NodeId) -> usize {
+        self.analyse(node)[node as usize].depth
     }
 
     /// The material, facet and visited cells at object-space point `p`; `u ∈ [0,1)` decides the

@@ -1,0 +1,423 @@
+//! Compiles a parsed [`GemRecipe`] into a runtime [`Scene`]: the material table, the flat map
+//! tree, the resolved stage and the effects set. Errors are collected, not returned at the first:
+//! an unknown name is reported and compilation goes on with a stand-in, so one run of
+//! `lapidary check` lists every problem it can find.
+
+use super::gem::GemRecipe;
+use super::surface::{BumpDesc, FieldDesc, MapDesc, SwitchDesc};
+use super::{RecipeError, did_you_mean};
+use crate::bsdf::{Model, StackDesc};
+use crate::sampler::hash_words;
+use crate::scene::{Effect, Effects, Scene, Surface};
+use crate::texture::{
+    Entry, FacetBump, FieldId, FieldNode, FieldTable, Map, MapNode, NodeId, Octaves, Stop, Tilt,
+    Voronoi, VoronoiNode,
+};
+use glam::Vec3;
+use indexmap::IndexMap;
+
+/// Deepest nesting of map nodes the compiler follows (through named maps too); the runtime tree
+/// has its own, equal limit ([`crate::texture::map::MAX_DEPTH`]).
+const MAX_NESTING: usize = crate::texture::map::MAX_DEPTH;
+
+/// Compilation state: the flat runtime arrays being filled, children before parents.
+pub(crate) struct Compiler<'a> {
+    recipe: &'a GemRecipe,
+    nodes: Vec<MapNode>,
+    entries: Vec<Entry>,
+    stops: Vec<Stop>,
+    fields: FieldTable,
+    /// Named maps: `None` while being compiled (to catch cycles), then their node.
+    named: IndexMap<String, Option<NodeId>>,
+    /// Running count of seeded nodes, for default seeds.
+    counter: u64,
+    /// Library index → surface material index, in first-use order after the recipe's own.
+    materials: IndexMap<usize, u32>,
+    /// Unknown names already reported.
+    reported: Vec<String>,
+    depth: usize,
+    effects: Effects,
+    errors: Vec<RecipeError>,
+}
+
+impl<'a> Compiler<'a> {
+    pub(crate) fn new(recipe: &'a GemRecipe) -> Self {
+        // The recipe's own materials keep their file order as indices 0, 1, …
+        let own = recipe.content.materials.len();
+        Compiler {
+            recipe,
+            nodes: vec![],
+            entries: vec![],
+            stops: vec![],
+            fields: FieldTable::default(),
+            named: IndexMap::new(),
+            counter: 0,
+            materials: (0..own).map(|i| (i, i as u32)).collect(),
+            reported: vec![],
+            depth: 0,
+            effects: Effects::default(),
+            errors: vec![],
+        }
+    }
+
+    /// Compiles everything, appending errors to `errors`; the scene when none were found.
+    pub(crate) fn run(mut self, errors: &mut Vec<RecipeError>) -> Option<Scene> {
+        let r = self.recipe;
+        let own = r.content.materials.len();
+        let root = self.node(&r.content.surface, "surface");
+        let mut used = vec![false; self.materials.len()];
+        let (nodes, entries, stops, fields) = (
+            std::mem::take(&mut self.nodes),
+            std::mem::take(&mut self.entries),
+            std::mem::take(&mut self.stops),
+            std::mem::take(&mut self.fields),
+        );
+        for n in &nodes {
+            if let MapNode::Material(m) = n {
+                used[*m as usize] = true;
+            }
+        }
+        let map = match Map::new(nodes, entries, stops, fields, root) {
+            Ok(map) => Some(map),
+            Err(e) => {
+                if self.errors.is_empty() {
+                    let at = r.source.find(&["surface", ":"]);
+                    self.errors.push(r.source.error(at, format!("surface: {e}")));
+                }
+                None
+            }
+        };
+        let mut names = Vec::with_capacity(self.materials.len());
+        let mut stacks = Vec::with_capacity(self.materials.len());
+        let table: Vec<(usize, u32)> = self.materials.iter().map(|(a, b)| (*a, *b)).collect();
+        for (lib_index, surface_index) in table {
+            let name = r
+                .library
+                .names()
+                .nth(lib_index)
+                .expect("indices come from the library")
+                .to_string();
+            debug_assert_eq!(surface_index as usize, names.len());
+            // Errors in materials were reported when the library was read.
+            if let Ok(stack) = r.library.stack(&name) {
+                if used[surface_index as usize] {
+                    self.stack_effects(&name, &stack);
+                }
+                stacks.push(stack);
+            }
+            names.push(name);
+        }
+        let stage = super::resolve::stage(r, &mut self.effects, &mut self.errors);
+        let hash = recipe_hash(r);
+        let ok = self.errors.is_empty() && stacks.len() == names.len();
+        errors.append(&mut self.errors);
+        let (map, stage) = (map?, stage?);
+        ok.then(|| Scene {
+            surface: Surface {
+                names,
+                stacks,
+                map,
+                used: used.iter().enumerate().map(|(i, u)| *u || i >= own).collect(),
+            },
+            stage,
+            effects: self.effects,
+            hash,
+        })
+    }
+
+    /// Effects a used material calls for.
+    fn stack_effects(&mut self, name: &str, stack: &StackDesc) {
+        let file = self.recipe.library.file_of(name).unwrap_or("?").to_string();
+        for (i, c) in stack.coats.iter().enumerate() {
+            if c.thickness > 0.0 && c.absorption.max_channel() > 0.0 {
+                self.effects.turn_on(
+                    Effect::Absorption,
+                    format!("material \"{name}\" coats[{i}] ({file})"),
+                );
+            }
+        }
+        let t_term = stack.t_term.unwrap_or(matches!(stack.model, Model::Course));
+        if !stack.coats.is_empty() && t_term && !matches!(stack.model, Model::Reference(_)) {
+            self.effects.turn_on(
+                Effect::TTerm,
+                format!("material \"{name}\" ({file}, {:?} model)", stack.model),
+            );
+        }
+    }
+
+    fn push(&mut self, node: MapNode) -> NodeId {
+        self.nodes.push(node);
+        (self.nodes.len() - 1) as NodeId
+    }
+
+    /// The seed of the next seeded node: the explicit one, or one derived from its position.
+    fn seed(&mut self, explicit: Option<u64>) -> u64 {
+        self.counter += 1;
+        match explicit {
+            Some(s) => hash_words(&[self.recipe.content.seed, 0x5eed, s]),
+            None => hash_words(&[self.recipe.content.seed, 0xdef, self.counter]),
+        }
+    }
+
+    /// Reports an unknown name once, at its first use in the file.
+    fn unknown(&mut self, kind: &str, name: &str, message: String) {
+        let key = format!("{kind}({name})");
+        if self.reported.contains(&key) {
+            return;
+        }
+        self.reported.push(key);
+        let r = self.recipe;
+        let at = r.source.find(&[kind, "(", &format!("{name:?}")]);
+        self.errors.push(r.source.error(at, message));
+    }
+
+    /// Compiles `desc`, found at tree path `at` (e.g. `surface.over`), into a node.
+    fn node(&mut self, desc: &MapDesc, at: &str) -> NodeId {
+        if self.depth >= MAX_NESTING {
+            let message = format!(
+                "{at}: maps nest more than {MAX_NESTING} levels deep, too deep to evaluate"
+            );
+            if !self.errors.iter().any(|e| e.message.contains("too deep")) {
+                let pos = self.recipe.source.find(&["surface", ":"]);
+                self.errors.push(self.recipe.source.error(pos, message));
+            }
+            return self.push(MapNode::Material(0));
+        }
+        self.depth += 1;
+        let id = self.node_inner(desc, at);
+        self.depth -= 1;
+        id
+    }
+
+    fn node_inner(&mut self, desc: &MapDesc, at: &str) -> NodeId {
+        let r = self.recipe;
+        match desc {
+            MapDesc::Material(name) => {
+                let Some(lib_index) = r.library.index_of(name) else {
+                    let message = r.library.unknown(name);
+                    self.unknown("Material", name, message);
+                    return self.push(MapNode::Material(0));
+                };
+                let next = self.materials.len() as u32;
+                let m = *self.materials.entry(lib_index).or_insert(next);
+                self.push(MapNode::Material(m))
+            }
+            MapDesc::Map(name) => {
+                match self.named.get(name) {
+                    Some(Some(id)) => return *id,
+                    Some(None) => {
+                        self.unknown(
+                            "Map",
+                            name,
+                            format!("map \"{name}\" contains itself (a cycle through `maps`)"),
+                        );
+                        return self.push(MapNode::Material(0));
+                    }
+                    None => {}
+                }
+                let Some(sub) = r.content.maps.get(name) else {
+                    let hint = did_you_mean(name, r.content.maps.keys().map(String::as_str))
+                        .map(|s| format!(" (did you mean \"{s}\"?)"))
+                        .unwrap_or_default();
+                    let known: Vec<&str> = r.content.maps.keys().map(String::as_str).collect();
+                    self.unknown(
+                        "Map",
+                        name,
+                        format!(
+                            "unknown map \"{name}\"{hint}; `maps` defines: {}",
+                            if known.is_empty() {
+                                "nothing".to_string()
+                            } else {
+                                known.join(", ")
+                            }
+                        ),
+                    );
+                    return self.push(MapNode::Material(0));
+                };
+                self.named.insert(name.clone(), None);
+                let id = self.node(sub, &format!("maps.{name:?}"));
+                self.named.insert(name.clone(), Some(id));
+                id
+            }
+            MapDesc::Voronoi {
+                scale,
+                jitter,
+                seed,
+                entries,
+                fill,
+                bump,
+            } => {
+                let seed = self.seed(*seed);
+                let children: Vec<(f32, NodeId)> = entries
+                    .iter()
+                    .enumerate()
+                    .map(|(k, (w, d))| (w.0, self.node(d, &format!("{at}.entries[{k}]"))))
+                    .collect();
+                let total: f64 = children.iter().map(|(w, _)| f64::from(*w)).sum();
+                let first = self.entries.len() as u32;
+                let mut run = 0.0f64;
+                for (k, (w, node)) in children.iter().enumerate() {
+                    run += f64::from(*w);
+                    let cumulative = if k + 1 == children.len() {
+                        1.0
+                    } else {
+                        (run / total) as f32
+                    };
+                    self.entries.push(Entry {
+                        cumulative,
+                        node: *node,
+                    });
+                }
+                let bump = bump.as_ref().map(|b| FacetBump {
+                    tilt: match *b {
+                        BumpDesc::Cone { half_angle } => Tilt::Cone { half_angle },
+                        BumpDesc::Beckmann { rms } => Tilt::Beckmann { rms },
+                    },
+                });
+                if let Some(b) = bump.filter(|b| match b.tilt {
+                    Tilt::Cone { half_angle } => half_angle > 0.0,
+                    Tilt::Beckmann { rms } => rms > 0.0,
+                }) {
+                    self.effects
+                        .turn_on(Effect::FacetBump, format!("{at}.bump = {:?}", b.tilt));
+                }
+                self.push(MapNode::Voronoi(VoronoiNode {
+                    basis: Voronoi::new(seed, *jitter),
+                    inv_scale: 1.0 / scale,
+                    first,
+                    count: children.len() as u32,
+                    fill: *fill,
+                    bump,
+                }))
+            }
+            MapDesc::Overlay { under, over } => {
+                let under = self.node(under, &format!("{at}.under"));
+                let over = self.node(over, &format!("{at}.over"));
+                self.effects
+                    .turn_on(Effect::GlitterOverlay, format!("{at} (Overlay)"));
+                self.push(MapNode::Overlay { under, over })
+            }
+            MapDesc::Switch(SwitchDesc(s)) => {
+                let field = self.field(&s.by);
+                let children: Vec<(f32, NodeId)> = s
+                    .stops
+                    .iter()
+                    .enumerate()
+                    .map(|(k, (t, d))| (*t, self.node(d, &format!("{at}.stops[{k}]"))))
+                    .collect();
+                let first = self.stops.len() as u32;
+                self.stops.extend(
+                    children
+                        .iter()
+                        .map(|&(threshold, node)| Stop { threshold, node }),
+                );
+                if s.blend > 0.0 && children.len() > 1 {
+                    self.effects.turn_on(
+                        Effect::StochasticSwitch,
+                        format!("{at} (Switch, blend {})", s.blend),
+                    );
+                }
+                self.push(MapNode::Switch {
+                    field,
+                    first,
+                    count: children.len() as u32,
+                    blend: s.blend,
+                })
+            }
+        }
+    }
+
+    fn field(&mut self, desc: &FieldDesc) -> FieldId {
+        let octaves = |this: &mut Self, n: u32, gain: f32, lacunarity: f32, seed: Option<u64>| {
+            let s = this.seed(seed);
+            Octaves {
+                octaves: n,
+                gain,
+                lacunarity,
+                seed: (s ^ (s >> 32)) as u32,
+            }
+        };
+        let node = match desc {
+            FieldDesc::Constant(c) => FieldNode::Constant(*c),
+            FieldDesc::Perlin {
+                scale,
+                octaves: n,
+                gain,
+                lacunarity,
+                seed,
+            } => FieldNode::Fbm {
+                inv_scale: 1.0 / scale,
+                octaves: octaves(self, *n, *gain, *lacunarity, *seed),
+            },
+            FieldDesc::Turbulence {
+                scale,
+                octaves: n,
+                gain,
+                lacunarity,
+                seed,
+            } => FieldNode::Turbulence {
+                inv_scale: 1.0 / scale,
+                octaves: octaves(self, *n, *gain, *lacunarity, *seed),
+            },
+            FieldDesc::Marble {
+                scale,
+                axis,
+                turbulence,
+                octaves: n,
+                gain,
+                lacunarity,
+                seed,
+            } => FieldNode::Marble {
+                inv_scale: 1.0 / scale,
+                axis: Vec3::new(axis.0, axis.1, axis.2).normalize(),
+                turbulence: *turbulence,
+                octaves: octaves(self, *n, *gain, *lacunarity, *seed),
+            },
+            FieldDesc::Sum(list) | FieldDesc::Product(list) => {
+                let ids: Vec<FieldId> = list.iter().map(|f| self.field(f)).collect();
+                let (first, count) = self.fields.add_args(&ids);
+                if matches!(desc, FieldDesc::Sum(_)) {
+                    FieldNode::Sum { first, count }
+                } else {
+                    FieldNode::Product { first, count }
+                }
+            }
+            FieldDesc::Remap {
+                field,
+                from,
+                to,
+                clamp,
+            } => FieldNode::Remap {
+                input: self.field(field),
+                from: [from.0, from.1],
+                to: [to.0, to.1],
+                clamp: *clamp,
+            },
+        };
+        match self.fields.add(node) {
+            Ok(id) => id,
+            Err(e) => {
+                // Unreachable for parsed input (children are added first); keep it an error.
+                let r = self.recipe;
+                self.errors.push(r.source.error(None, format!("internal: {e}")));
+                0
+            }
+        }
+    }
+}
+
+/// A 64-bit hash of the recipe's text and of every file it includes (for render metadata): the
+/// same files give the same hash.
+fn recipe_hash(r: &GemRecipe) -> u64 {
+    let mut words = vec![];
+    for source in r.library.sources() {
+        let bytes = source.text.as_bytes();
+        words.extend(bytes.chunks(8).map(|c| {
+            let mut b = [0u8; 8];
+            b[..c.len()].copy_from_slice(c);
+            u64::from_le_bytes(b)
+        }));
+        words.push(bytes.len() as u64);
+    }
+    hash_words(&words)
+}

@@ -1,0 +1,246 @@
+//! Resolves a recipe's `stage` over the studio stage: replaced parts converted to runtime form,
+//! files (meshes, environment maps) checked to exist relative to the recipe, geometry checked
+//! (a light facing its own centre, a camera looking along its up vector), and the stage's effects
+//! (depth of field, environment importance sampling) turned on with their reasons.
+
+use super::RecipeError;
+use super::gem::GemRecipe;
+use super::stage::{
+    CameraDesc, EnvironmentDesc, FilterDesc, GroundDesc, LightDesc, SamplerDesc, ShapeDesc,
+};
+use crate::color::Spectrum;
+use crate::scene::stage::{
+    AreaLight, Camera, Environment, Filter, Ground, LightShape, Projection, SamplerKind, Shape,
+    Stage, placement, rect_light,
+};
+use crate::scene::{Effect, Effects};
+use glam::Vec3;
+use std::path::PathBuf;
+
+fn v3(v: (f32, f32, f32)) -> Vec3 {
+    Vec3::new(v.0, v.1, v.2)
+}
+
+/// The resolved stage, or `None` after pushing errors.
+pub(crate) fn stage(
+    r: &GemRecipe,
+    effects: &mut Effects,
+    errors: &mut Vec<RecipeError>,
+) -> Option<Stage> {
+    let mut stage = Stage::studio();
+    let n_errors = errors.len();
+    let src = &r.source;
+    let stage_at = src.find(&["stage", ":"]);
+    let part_at = |name: &str| {
+        stage_at
+            .and_then(|s| src.find_from(s, &[name, ":"]))
+            .or(stage_at)
+    };
+    // A referenced file relative to the recipe: must be a regular file with the right extension.
+    let mut file = |name: &str, ext: &str, what: &str| -> Option<PathBuf> {
+        let at = src.find(&[&format!("{name:?}")]).or(stage_at);
+        let path = r.base_dir().join(name);
+        let ok_ext = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case(ext));
+        if !ok_ext {
+            errors.push(src.error(
+                at,
+                format!("{what} \"{name}\": expected a .{ext} file"),
+            ));
+            None
+        } else if !path.is_file() {
+            errors.push(src.error(
+                at,
+                format!(
+                    "{what} \"{name}\": no such file ({} relative to the recipe)",
+                    path.display()
+                ),
+            ));
+            None
+        } else {
+            Some(path)
+        }
+    };
+    let colour = |c: &super::color::ColorDesc| c.to_spectrum().unwrap_or(Spectrum::ZERO);
+
+    let Some(desc) = &r.content.stage else {
+        return Some(stage);
+    };
+    if let Some(shape) = &desc.shape {
+        stage.shape = match shape {
+            ShapeDesc::Sphere { radius } => Shape::Sphere { radius: *radius },
+            ShapeDesc::Cabochon {
+                radius,
+                height,
+                base,
+            } => Shape::Cabochon {
+                radius: *radius,
+                height: *height,
+                base: *base,
+            },
+            ShapeDesc::Slab { size } => Shape::Slab { size: v3(*size) },
+            ShapeDesc::Mesh { file: name, scale } => Shape::Mesh {
+                path: file(name, "obj", "mesh").unwrap_or_default(),
+                scale: *scale,
+            },
+        };
+    }
+    if let Some(t) = &desc.transform {
+        stage.to_world = placement(t.scale, v3(t.rotate), v3(t.translate));
+    }
+    if let Some(g) = &desc.ground {
+        stage.ground = match g {
+            GroundDesc::Off => None,
+            GroundDesc::Plane { height, albedo } => Some(Ground {
+                height: *height,
+                albedo: colour(albedo),
+            }),
+        };
+    }
+    if let Some(env) = &desc.environment {
+        stage.environment = match env {
+            EnvironmentDesc::Constant(c) => Environment::Constant(colour(c)),
+            EnvironmentDesc::Gradient {
+                zenith,
+                horizon,
+                nadir,
+            } => Environment::Gradient {
+                zenith: colour(zenith),
+                horizon: colour(horizon),
+                nadir: colour(nadir),
+            },
+            EnvironmentDesc::Map {
+                file: name,
+                intensity,
+                rotate,
+            } => Environment::Map {
+                path: file(name, "exr", "environment map").unwrap_or_default(),
+                intensity: *intensity,
+                rotate: rotate.to_radians(),
+            },
+        };
+    }
+    if let Some(lights) = &desc.lights {
+        let lights_at = part_at("lights");
+        stage.lights.clear();
+        for (i, l) in lights.iter().enumerate() {
+            let (center, target) = match l {
+                LightDesc::Rect { center, target, .. } | LightDesc::Disc { center, target, .. } => {
+                    (v3(*center), v3(*target))
+                }
+            };
+            if (target - center).length() <= 1e-6 * center.length().max(1.0) {
+                errors.push(src.error(
+                    lights_at,
+                    format!("stage.lights[{i}]: `target` equals `center`; a light must face a point away from itself"),
+                ));
+                continue;
+            }
+            stage.lights.push(match l {
+                LightDesc::Rect {
+                    size,
+                    radiance,
+                    intensity,
+                    two_sided,
+                    ..
+                } => AreaLight {
+                    two_sided: *two_sided,
+                    ..rect_light(center, target, *size, colour(radiance) * *intensity)
+                },
+                LightDesc::Disc {
+                    radius,
+                    radiance,
+                    intensity,
+                    two_sided,
+                    ..
+                } => AreaLight {
+                    center,
+                    normal: (target - center).normalize(),
+                    shape: LightShape::Disc { radius: *radius },
+                    radiance: colour(radiance) * *intensity,
+                    two_sided: *two_sided,
+                },
+            });
+        }
+    }
+    if let Some(cam) = &desc.camera {
+        let (from, to, up, projection) = match cam {
+            CameraDesc::Perspective {
+                from,
+                to,
+                up,
+                fov,
+                aperture,
+                focus_distance,
+            } => (
+                v3(*from),
+                v3(*to),
+                v3(*up),
+                Projection::Perspective {
+                    fov: fov.to_radians(),
+                    aperture: *aperture,
+                    focus_distance: focus_distance.unwrap_or((v3(*to) - v3(*from)).length()),
+                },
+            ),
+            CameraDesc::Orthographic {
+                from,
+                to,
+                up,
+                height,
+            } => (
+                v3(*from),
+                v3(*to),
+                v3(*up),
+                Projection::Orthographic { height: *height },
+            ),
+        };
+        match Camera::look_at(from, to, up, projection) {
+            Some(c) => stage.camera = c,
+            None => errors.push(src.error(
+                part_at("camera"),
+                "stage.camera: `to` must differ from `from`, and `up` must not be parallel to the view direction",
+            )),
+        }
+    }
+    let rd = &desc.render;
+    let rs = &mut stage.render;
+    rs.width = rd.width.unwrap_or(rs.width);
+    rs.height = rd.height.unwrap_or(rs.height);
+    rs.spp = rd.spp.unwrap_or(rs.spp);
+    rs.max_depth = rd.max_depth.unwrap_or(rs.max_depth);
+    rs.exposure = rd.exposure.unwrap_or(rs.exposure);
+    rs.seed = rd.seed.unwrap_or(rs.seed);
+    if let Some(s) = rd.sampler {
+        rs.sampler = match s {
+            SamplerDesc::Independent => SamplerKind::Independent,
+            SamplerDesc::Sobol => SamplerKind::Sobol,
+        };
+    }
+    if let Some(f) = rd.filter {
+        rs.filter = match f {
+            FilterDesc::Box => Filter::Box,
+            FilterDesc::Gaussian { radius } => Filter::Gaussian { radius },
+        };
+    }
+    stage_effects(&stage, effects);
+    (errors.len() == n_errors).then_some(stage)
+}
+
+/// Effects the stage calls for.
+pub(crate) fn stage_effects(stage: &Stage, effects: &mut Effects) {
+    if let Projection::Perspective { aperture, .. } = stage.camera.projection
+        && aperture > 0.0
+    {
+        effects.turn_on(
+            Effect::DepthOfField,
+            format!("stage.camera aperture = {aperture}"),
+        );
+    }
+    if let Environment::Map { path, .. } = &stage.environment {
+        effects.turn_on(
+            Effect::EnvironmentImportance,
+            format!("stage.environment Map(\"{}\")", path.display()),
+        );
+    }
+}

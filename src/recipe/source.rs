@@ -1,0 +1,296 @@
+//! A description file's text and the positions of things in it.
+//!
+//! The RON parser reports positions for syntax and range errors it finds while reading. Errors found
+//! after parsing (an unknown material name, an include that is missing, a bad coat) are located by
+//! searching the text for the tokens that name them, skipping comments and the insides of other
+//! strings, so a name quoted in a comment never attracts an error.
+
+use super::RecipeError;
+use std::ops::Range;
+
+/// Largest description file read (bytes): recipes are hand-written text, and the limit keeps a
+/// mistaken include of a huge or endless file (`/dev/zero`) from exhausting memory.
+pub const MAX_FILE_BYTES: u64 = 16 << 20;
+
+/// A file's name (as given, for messages) and text.
+#[derive(Clone, Debug)]
+pub struct Source {
+    /// File name as given.
+    pub file: String,
+    /// The text.
+    pub text: String,
+    /// Byte ranges of comments.
+    comments: Vec<Range<usize>>,
+}
+
+impl Source {
+    /// A source over `text`, named `file` in messages.
+    pub fn new(file: &str, text: &str) -> Self {
+        Source {
+            file: file.to_string(),
+            text: text.to_string(),
+            comments: comment_ranges(text),
+        }
+    }
+
+    /// Reads a file: a regular file of at most [`MAX_FILE_BYTES`], valid UTF-8.
+    pub fn read(path: &std::path::Path) -> Result<Self, RecipeError> {
+        let file = path.display().to_string();
+        let fail = |message: String| RecipeError {
+            file: file.clone(),
+            line: 0,
+            col: 0,
+            message,
+        };
+        let meta = std::fs::metadata(path).map_err(|e| fail(format!("cannot read the file: {e}")))?;
+        if !meta.is_file() {
+            return Err(fail("not a regular file".into()));
+        }
+        if meta.len() > MAX_FILE_BYTES {
+            return Err(fail(format!(
+                "the file has {} bytes; description files may have at most {MAX_FILE_BYTES}",
+                meta.len()
+            )));
+        }
+        let bytes = std::fs::read(path).map_err(|e| fail(format!("cannot read the file: {e}")))?;
+        let text = String::from_utf8(bytes).map_err(|e| {
+            let (line, col) = line_col_bytes(e.as_bytes(), e.utf8_error().valid_up_to());
+            RecipeError {
+                file: file.clone(),
+                line,
+                col,
+                message: "the file is not valid UTF-8 text".into(),
+            }
+        })?;
+        Ok(Source::new(&file, &text))
+    }
+
+    /// An error at byte offset `at` (or with no position when `at` is `None`).
+    pub fn error(&self, at: Option<usize>, message: impl Into<String>) -> RecipeError {
+        let (line, col) = at.map_or((0, 0), |p| line_col(&self.text, p));
+        RecipeError {
+            file: self.file.clone(),
+            line,
+            col,
+            message: message.into(),
+        }
+    }
+
+    /// An error from the RON parser.
+    pub fn ron_error(&self, e: &ron::error::SpannedError) -> RecipeError {
+        RecipeError {
+            file: self.file.clone(),
+            line: e.span.start.line,
+            col: e.span.start.col,
+            message: e.code.to_string(),
+        }
+    }
+
+    fn in_comment(&self, pos: usize) -> bool {
+        self.comments.iter().any(|r| r.contains(&pos))
+    }
+
+    /// Byte offsets of every occurrence, outside comments, of the token sequence `parts` (each
+    /// part may be preceded by whitespace), e.g. `["Material", "(", "\"x\""]`. Identifier-like
+    /// parts must stand alone (not inside a longer identifier).
+    pub fn find_all(&self, parts: &[&str]) -> Vec<usize> {
+        let mut found = vec![];
+        let Some(first) = parts.first() else {
+            return found;
+        };
+        let src = &self.text;
+        let mut start = 0;
+        while let Some(off) = src[start..].find(first) {
+            let at = start + off;
+            start = at + first.len();
+            if self.in_comment(at) || !token_boundary(src, at, first) {
+                continue;
+            }
+            let mut pos = at + first.len();
+            let ok = parts[1..].iter().all(|p| {
+                let rest = &src[pos..];
+                let trimmed = rest.trim_start();
+                pos += rest.len() - trimmed.len();
+                if trimmed.starts_with(p) && token_boundary(src, pos, p) {
+                    pos += p.len();
+                    true
+                } else {
+                    false
+                }
+            });
+            if ok {
+                found.push(at);
+            }
+        }
+        found
+    }
+
+    /// The first occurrence of `parts` at or after byte `from`, outside comments.
+    pub fn find_from(&self, from: usize, parts: &[&str]) -> Option<usize> {
+        self.find_all(parts).into_iter().find(|&p| p >= from)
+    }
+
+    /// The first occurrence of `parts`, outside comments.
+    pub fn find(&self, parts: &[&str]) -> Option<usize> {
+        self.find_all(parts).into_iter().next()
+    }
+
+    /// Where the key `"name":` of a map (e.g. a material in `materials`) is written.
+    pub fn key(&self, name: &str) -> Option<usize> {
+        self.find(&[&format!("\"{name}\""), ":"])
+    }
+
+    /// Locates the field a message starts with (e.g. `coats[1].ior: …`) within the entry whose key
+    /// is `name`; falls back to the key itself.
+    pub fn locate_field(&self, name: &str, message: &str) -> Option<usize> {
+        let key = self.key(name)?;
+        let mut pos = key;
+        let path = message.split([' ', ':']).next().unwrap_or("");
+        for seg in path.split('.') {
+            let (field, index) = match seg.split_once('[') {
+                Some((f, rest)) => (f, rest.trim_end_matches(']').parse::<usize>().ok()),
+                None => (seg, None),
+            };
+            if field.is_empty() || !field.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
+                break;
+            }
+            let Some(p) = self.find_from(pos, &[field]) else {
+                break;
+            };
+            pos = p;
+            if let Some(i) = index {
+                pos = self.nth_element(pos, i).unwrap_or(pos);
+            }
+        }
+        Some(pos)
+    }
+
+    /// The start of the `i`-th parenthesised element of the list that follows `from`.
+    fn nth_element(&self, from: usize, i: usize) -> Option<usize> {
+        let mut depth = 0i32;
+        let mut count = 0usize;
+        for (off, ch) in self.text[from..].char_indices() {
+            if self.in_comment(from + off) {
+                continue;
+            }
+            match ch {
+                '(' | '[' | '{' => {
+                    depth += 1;
+                    if depth == 2 && ch == '(' {
+                        if count == i {
+                            return Some(from + off);
+                        }
+                        count += 1;
+                    }
+                }
+                ')' | ']' | '}' => {
+                    depth -= 1;
+                    if depth <= 0 {
+                        return None;
+                    }
+                }
+                _ => {}
+            }
+        }
+        None
+    }
+}
+
+/// Whether an identifier-like `token` at byte `at` stands alone.
+fn token_boundary(src: &str, at: usize, token: &str) -> bool {
+    let ident = |c: char| c.is_ascii_alphanumeric() || c == '_';
+    if !token.chars().next().is_some_and(ident) {
+        return true;
+    }
+    let before = src[..at].chars().next_back();
+    let after = src[at + token.len()..].chars().next();
+    !before.is_some_and(ident) && !after.is_some_and(ident)
+}
+
+/// Byte ranges of `// …` and (nested) `/* … */` comments, outside string literals.
+fn comment_ranges(text: &str) -> Vec<Range<usize>> {
+    let b = text.as_bytes();
+    let mut out = vec![];
+    let mut i = 0;
+    while i < b.len() {
+        match b[i] {
+            b'"' => {
+                i += 1;
+                while i < b.len() && b[i] != b'"' {
+                    i += if b[i] == b'\\' { 2 } else { 1 };
+                }
+                i += 1;
+            }
+            b'/' if b.get(i + 1) == Some(&b'/') => {
+                let end = text[i..].find('\n').map_or(b.len(), |e| i + e);
+                out.push(i..end);
+                i = end;
+            }
+            b'/' if b.get(i + 1) == Some(&b'*') => {
+                let start = i;
+                let mut depth = 0;
+                while i < b.len() {
+                    if b[i] == b'/' && b.get(i + 1) == Some(&b'*') {
+                        depth += 1;
+                        i += 2;
+                    } else if b[i] == b'*' && b.get(i + 1) == Some(&b'/') {
+                        depth -= 1;
+                        i += 2;
+                        if depth == 0 {
+                            break;
+                        }
+                    } else {
+                        i += 1;
+                    }
+                }
+                out.push(start..i.min(b.len()));
+            }
+            _ => i += 1,
+        }
+    }
+    out
+}
+
+/// 1-based line and column (in characters) of byte offset `pos`.
+pub(crate) fn line_col(source: &str, pos: usize) -> (usize, usize) {
+    let mut pos = pos.min(source.len());
+    while !source.is_char_boundary(pos) {
+        pos -= 1;
+    }
+    let before = &source[..pos];
+    let line = before.matches('\n').count() + 1;
+    let col = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+    (line, col)
+}
+
+fn line_col_bytes(bytes: &[u8], pos: usize) -> (usize, usize) {
+    line_col(&String::from_utf8_lossy(&bytes[..pos.min(bytes.len())]), pos)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn finds_tokens_outside_comments_and_strings() {
+        let s = Source::new(
+            "x",
+            "// Material(\"a\")\n/* Material(\"a\") /* nested */ */ x: \"// not\", Material ( \"a\" )",
+        );
+        let at = s.find(&["Material", "(", "\"a\""]).unwrap();
+        assert_eq!(line_col(&s.text, at), (2, 47));
+        assert_eq!(s.find_all(&["Material", "(", "\"a\""]).len(), 1);
+        // Identifiers stand alone.
+        assert!(Source::new("x", "MaterialX(\"a\")").find(&["Material"]).is_none());
+    }
+
+    #[test]
+    fn locates_fields_of_keyed_entries() {
+        let s = Source::new(
+            "x",
+            "{\n \"m\": (\n  coats: [(ior: 1.5), (ior: 0.5)],\n ),\n}",
+        );
+        let at = s.locate_field("m", "coats[1].ior = 0.5").unwrap();
+        assert_eq!(line_col(&s.text, at), (3, 24));
+    }
+}

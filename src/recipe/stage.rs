@@ -1,0 +1,442 @@
+//! Serde description of a recipe's `stage`: the stone's shape and placement, the ground, the
+//! environment, the lights, the camera and the render settings. Every part is optional and
+//! replaces the same part of the built-in studio stage ([`crate::scene::Stage::studio`]); `render`
+//! overrides the studio's settings field by field.
+//!
+//! World space is right-handed with **y up**; lengths are in object units (the studio cabochon is
+//! about 2 units across); angles are in degrees; radiance is linear Rec.709 RGB, relative.
+//!
+//! ```ron
+//! stage: (
+//!     shape: Cabochon(radius: (1.0, 0.8), height: 0.55),
+//!     transform: (rotate: (0.0, 30.0, 0.0)),
+//!     ground: Plane(albedo: Gray(0.3)),
+//!     environment: Gradient(zenith: Gray(0.08), horizon: Gray(0.05), nadir: Gray(0.02)),
+//!     lights: [Rect(center: (-2.5, 4.0, 2.0), size: (3.0, 2.0), radiance: Gray(4.0))],
+//!     camera: Perspective(from: (0.0, 2.6, 4.2), to: (0.0, 0.15, 0.0), fov: 30.0),
+//!     render: (width: 480, height: 360, spp: 64),
+//! )
+//! ```
+
+use super::color::ColorDesc;
+use serde::{Deserialize, Deserializer, Serialize};
+
+ranged!(length_range, "length", open 0.0, 1e4);
+ranged!(fov_range, "fov", 1.0, 170.0);
+ranged!(aperture_range, "aperture", 0.0, 1e3);
+ranged!(intensity_range, "intensity", 0.0, 1e6);
+ranged!(exposure_range, "exposure", -30.0, 30.0);
+ranged!(filter_radius_range, "radius", 0.5, 4.0);
+ranged!(factor_range, "scale", open 0.0, 1e4);
+
+type V3 = (f32, f32, f32);
+
+fn finite3<'de, D: Deserializer<'de>>(d: D) -> Result<V3, D::Error> {
+    let v = V3::deserialize(d)?;
+    if v.0.is_finite() && v.1.is_finite() && v.2.is_finite() {
+        Ok(v)
+    } else {
+        Err(serde::de::Error::custom(format!(
+            "{v:?}: every coordinate must be a finite number"
+        )))
+    }
+}
+
+fn positive2<'de, D: Deserializer<'de>>(d: D) -> Result<(f32, f32), D::Error> {
+    let v = <(f32, f32)>::deserialize(d)?;
+    if [v.0, v.1].iter().all(|x| *x > 0.0 && *x <= 1e4) {
+        Ok(v)
+    } else {
+        Err(serde::de::Error::custom(format!(
+            "{v:?} is out of range: each size allowed 0 <.. 1e4"
+        )))
+    }
+}
+
+fn positive3<'de, D: Deserializer<'de>>(d: D) -> Result<V3, D::Error> {
+    let v = V3::deserialize(d)?;
+    if [v.0, v.1, v.2].iter().all(|x| *x > 0.0 && *x <= 1e4) {
+        Ok(v)
+    } else {
+        Err(serde::de::Error::custom(format!(
+            "{v:?} is out of range: each size allowed 0 <.. 1e4"
+        )))
+    }
+}
+
+fn base_range<'de, D: Deserializer<'de>>(d: D) -> Result<f32, D::Error> {
+    let v = f32::deserialize(d)?;
+    if (0.0..=1e4).contains(&v) {
+        Ok(v)
+    } else {
+        Err(serde::de::Error::custom(format!(
+            "base = {v} is out of range: allowed 0 ..= 1e4 (0: a flat base)"
+        )))
+    }
+}
+
+fn finite<'de, D: Deserializer<'de>>(d: D) -> Result<f32, D::Error> {
+    let v = f32::deserialize(d)?;
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(serde::de::Error::custom(format!(
+            "{v} must be a finite number"
+        )))
+    }
+}
+
+/// A colour that is emitted light: finite and ≥ 0 in every channel.
+fn radiance<'de, D: Deserializer<'de>>(d: D) -> Result<ColorDesc, D::Error> {
+    let c = ColorDesc::deserialize(d)?;
+    match c.to_spectrum() {
+        Ok(s) if s.0.iter().all(|v| *v >= 0.0) => Ok(c),
+        Ok(s) => Err(serde::de::Error::custom(format!(
+            "radiance {:?} is out of range: each channel allowed 0 ..= any finite value",
+            s.0
+        ))),
+        Err(e) => Err(serde::de::Error::custom(e)),
+    }
+}
+
+/// A reflectance: finite and within 0 ..= 1 in every channel.
+fn albedo<'de, D: Deserializer<'de>>(d: D) -> Result<ColorDesc, D::Error> {
+    let c = ColorDesc::deserialize(d)?;
+    match c.to_spectrum() {
+        Ok(s) if s.0.iter().all(|v| (0.0..=1.0).contains(v)) => Ok(c),
+        Ok(s) => Err(serde::de::Error::custom(format!(
+            "albedo {:?} is out of range: each channel allowed 0 ..= 1",
+            s.0
+        ))),
+        Err(e) => Err(serde::de::Error::custom(e)),
+    }
+}
+
+fn count<'de, D: Deserializer<'de>>(
+    d: D,
+    name: &str,
+    lo: u32,
+    hi: u32,
+) -> Result<Option<u32>, D::Error> {
+    let v = u32::deserialize(d)?;
+    if (lo..=hi).contains(&v) {
+        Ok(Some(v))
+    } else {
+        Err(serde::de::Error::custom(format!(
+            "{name} = {v} is out of range: allowed {lo} ..= {hi}"
+        )))
+    }
+}
+
+fn size_range<'de, D: Deserializer<'de>>(d: D) -> Result<Option<u32>, D::Error> {
+    count(d, "image size", 1, 16384)
+}
+fn spp_range<'de, D: Deserializer<'de>>(d: D) -> Result<Option<u32>, D::Error> {
+    count(d, "spp", 1, 1 << 20)
+}
+fn depth_range<'de, D: Deserializer<'de>>(d: D) -> Result<Option<u32>, D::Error> {
+    count(d, "max_depth", 1, 1024)
+}
+
+fn zero3() -> V3 {
+    (0.0, 0.0, 0.0)
+}
+fn y_up() -> V3 {
+    (0.0, 1.0, 0.0)
+}
+fn one() -> f32 {
+    1.0
+}
+fn thirty() -> f32 {
+    30.0
+}
+fn grey_half() -> ColorDesc {
+    ColorDesc::Gray(0.5)
+}
+
+/// The parts of the studio stage a recipe replaces.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StageDesc {
+    /// The stone's shape (object space; the surface maps are evaluated there).
+    #[serde(default)]
+    pub shape: Option<ShapeDesc>,
+    /// Object-to-world placement of the stone.
+    #[serde(default)]
+    pub transform: Option<TransformDesc>,
+    /// The floor under the stone.
+    #[serde(default)]
+    pub ground: Option<GroundDesc>,
+    /// Light from infinitely far away.
+    #[serde(default)]
+    pub environment: Option<EnvironmentDesc>,
+    /// Area lights (the list replaces the studio's soft boxes; `[]` removes them).
+    #[serde(default)]
+    pub lights: Option<Vec<LightDesc>>,
+    /// The camera.
+    #[serde(default)]
+    pub camera: Option<CameraDesc>,
+    /// Render settings, each overriding the studio's.
+    #[serde(default)]
+    pub render: RenderDesc,
+}
+
+/// The stone's shape, in object space (base on the plane y = 0, centred on the y axis).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum ShapeDesc {
+    /// A sphere centred at the origin.
+    Sphere {
+        /// Radius, 0 <.. 1e4.
+        #[serde(deserialize_with = "length_range")]
+        radius: f32,
+    },
+    /// An elliptical dome (half-ellipsoid of semi-axes `radius.0`, `height`, `radius.1` along x, y,
+    /// z) over a flat base (`base = 0`) or a shallower dome below (depth `base`).
+    Cabochon {
+        /// Semi-axes of the outline along x and z.
+        #[serde(deserialize_with = "positive2")]
+        radius: (f32, f32),
+        /// Dome height above the girdle.
+        #[serde(deserialize_with = "length_range")]
+        height: f32,
+        /// Depth of the lower dome; 0 (default) is a flat base.
+        #[serde(default, deserialize_with = "base_range")]
+        base: f32,
+    },
+    /// A polished plate (a box) for swatches: full sizes along x, y, z, centred above the origin.
+    Slab {
+        /// Full sizes.
+        #[serde(deserialize_with = "positive3")]
+        size: V3,
+    },
+    /// A triangle mesh from a Wavefront OBJ file (relative to the recipe).
+    Mesh {
+        /// The OBJ file.
+        file: String,
+        /// Uniform scale applied to the file's coordinates, 0 <.. 1e4 (default 1).
+        #[serde(default = "one", deserialize_with = "factor_range")]
+        scale: f32,
+    },
+}
+
+/// Object-to-world placement: scale, then rotations about x, y, z (degrees), then translation.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TransformDesc {
+    /// Translation.
+    #[serde(default = "zero3", deserialize_with = "finite3")]
+    pub translate: V3,
+    /// Rotation angles about x, y and z in degrees, applied in that order.
+    #[serde(default = "zero3", deserialize_with = "finite3")]
+    pub rotate: V3,
+    /// Uniform scale, 0 <.. 1e4 (default 1).
+    #[serde(default = "one", deserialize_with = "factor_range")]
+    pub scale: f32,
+}
+
+/// The floor.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum GroundDesc {
+    /// No floor.
+    Off,
+    /// An infinite Lambertian plane y = `height`.
+    Plane {
+        /// Height of the plane (default 0: the stone rests on it).
+        #[serde(default, deserialize_with = "finite")]
+        height: f32,
+        /// Reflectance, 0 ..= 1 per channel (default Gray(0.5)).
+        #[serde(default = "grey_half", deserialize_with = "albedo")]
+        albedo: ColorDesc,
+    },
+}
+
+/// Light arriving from infinitely far away.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum EnvironmentDesc {
+    /// The same radiance from every direction.
+    Constant(#[serde(deserialize_with = "radiance")] ColorDesc),
+    /// Radiance blending zenith → horizon above, horizon → nadir below (linear in the cosine).
+    Gradient {
+        /// Straight up.
+        #[serde(deserialize_with = "radiance")]
+        zenith: ColorDesc,
+        /// At the horizon.
+        #[serde(deserialize_with = "radiance")]
+        horizon: ColorDesc,
+        /// Straight down.
+        #[serde(deserialize_with = "radiance")]
+        nadir: ColorDesc,
+    },
+    /// A latitude–longitude (equirectangular) EXR image, y up, importance sampled.
+    Map {
+        /// The EXR file (relative to the recipe).
+        file: String,
+        /// Radiance multiplier, 0 ..= 1e6 (default 1).
+        #[serde(default = "one", deserialize_with = "intensity_range")]
+        intensity: f32,
+        /// Rotation about y in degrees (default 0).
+        #[serde(default, deserialize_with = "finite")]
+        rotate: f32,
+    },
+}
+
+/// An area light facing `target`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum LightDesc {
+    /// A rectangle (a soft box).
+    Rect {
+        /// Centre.
+        #[serde(deserialize_with = "finite3")]
+        center: V3,
+        /// The point it faces (default the origin).
+        #[serde(default = "zero3", deserialize_with = "finite3")]
+        target: V3,
+        /// Full width and height.
+        #[serde(deserialize_with = "positive2")]
+        size: (f32, f32),
+        /// Emitted radiance.
+        #[serde(deserialize_with = "radiance")]
+        radiance: ColorDesc,
+        /// Radiance multiplier, 0 ..= 1e6 (default 1).
+        #[serde(default = "one", deserialize_with = "intensity_range")]
+        intensity: f32,
+        /// Emit from both faces (default false: only towards `target`).
+        #[serde(default)]
+        two_sided: bool,
+    },
+    /// A disc.
+    Disc {
+        /// Centre.
+        #[serde(deserialize_with = "finite3")]
+        center: V3,
+        /// The point it faces (default the origin).
+        #[serde(default = "zero3", deserialize_with = "finite3")]
+        target: V3,
+        /// Radius.
+        #[serde(deserialize_with = "length_range")]
+        radius: f32,
+        /// Emitted radiance.
+        #[serde(deserialize_with = "radiance")]
+        radiance: ColorDesc,
+        /// Radiance multiplier, 0 ..= 1e6 (default 1).
+        #[serde(default = "one", deserialize_with = "intensity_range")]
+        intensity: f32,
+        /// Emit from both faces (default false).
+        #[serde(default)]
+        two_sided: bool,
+    },
+}
+
+/// The camera.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum CameraDesc {
+    /// A perspective camera with an optional thin lens.
+    Perspective {
+        /// Eye position.
+        #[serde(deserialize_with = "finite3")]
+        from: V3,
+        /// The point looked at.
+        #[serde(deserialize_with = "finite3")]
+        to: V3,
+        /// Up direction (default +y).
+        #[serde(default = "y_up", deserialize_with = "finite3")]
+        up: V3,
+        /// Vertical field of view in degrees, 1 ..= 170 (default 30).
+        #[serde(default = "thirty", deserialize_with = "fov_range")]
+        fov: f32,
+        /// Lens radius in object units, 0 ..= 1e3 (default 0: a pinhole, everything sharp).
+        #[serde(default, deserialize_with = "aperture_range")]
+        aperture: f32,
+        /// Distance to the plane in focus (default: `|to − from|`).
+        #[serde(default, deserialize_with = "focus_range")]
+        focus_distance: Option<f32>,
+    },
+    /// An orthographic camera.
+    Orthographic {
+        /// Eye position.
+        #[serde(deserialize_with = "finite3")]
+        from: V3,
+        /// The point looked at.
+        #[serde(deserialize_with = "finite3")]
+        to: V3,
+        /// Up direction (default +y).
+        #[serde(default = "y_up", deserialize_with = "finite3")]
+        up: V3,
+        /// Height of the view in object units.
+        #[serde(deserialize_with = "length_range")]
+        height: f32,
+    },
+}
+
+fn focus_range<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f32>, D::Error> {
+    let v = f32::deserialize(d)?;
+    if v > 0.0 && v <= 1e6 {
+        Ok(Some(v))
+    } else {
+        Err(serde::de::Error::custom(format!(
+            "focus_distance = {v} is out of range: allowed 0 <.. 1e6"
+        )))
+    }
+}
+
+/// Which numbers drive the pixel samples.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum SamplerDesc {
+    /// Independent uniform numbers from a hash of (seed, pixel, sample, dimension).
+    Independent,
+    /// Owen-scrambled Sobol' points (low discrepancy).
+    Sobol,
+}
+
+/// The pixel reconstruction filter.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum FilterDesc {
+    /// Each sample counts for the pixel it falls in.
+    Box,
+    /// A truncated Gaussian of standard deviation `radius / 3` pixels.
+    Gaussian {
+        /// Support radius in pixels, 0.5 ..= 4 (default 1.5).
+        #[serde(deserialize_with = "filter_radius_range")]
+        radius: f32,
+    },
+}
+
+/// Render settings; every field left out keeps the studio's value.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RenderDesc {
+    /// Image width in pixels, 1 ..= 16384.
+    #[serde(default, deserialize_with = "size_range")]
+    pub width: Option<u32>,
+    /// Image height in pixels, 1 ..= 16384.
+    #[serde(default, deserialize_with = "size_range")]
+    pub height: Option<u32>,
+    /// Samples per pixel, 1 ..= 2²⁰.
+    #[serde(default, deserialize_with = "spp_range")]
+    pub spp: Option<u32>,
+    /// Longest path in bounces, 1 ..= 1024.
+    #[serde(default, deserialize_with = "depth_range")]
+    pub max_depth: Option<u32>,
+    /// The sampler.
+    #[serde(default)]
+    pub sampler: Option<SamplerDesc>,
+    /// The pixel filter.
+    #[serde(default)]
+    pub filter: Option<FilterDesc>,
+    /// Exposure of the PNG in stops (EV), −30 ..= 30.
+    #[serde(default, deserialize_with = "exposure_opt")]
+    pub exposure: Option<f32>,
+    /// Seed of the pixel samples (not of the maps: that is the recipe's `seed`).
+    #[serde(default)]
+    pub seed: Option<u64>,
+}
+
+fn exposure_opt<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f32>, D::Error> {
+    exposure_range(d).map(Some)
+}

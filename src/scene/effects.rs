@@ -1,0 +1,158 @@
+//! The effects set: which optional parts of the simulation a compiled scene needs, and which
+//! recipe element turned each one on (DESIGN §5). The renderer tests a bit per effect and skips the
+//! work of every effect that is off; `lapidary info` prints the reasons.
+
+use std::fmt;
+
+/// An optional part of the simulation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[repr(u8)]
+pub enum Effect {
+    /// Absorption in a coat (a varnish with `thickness > 0` and a non-zero absorption or tint).
+    Absorption,
+    /// The course's internal-reflection `t` term (eq. 3.3) in a layered evaluation.
+    TTerm,
+    /// Crystal-facet bump: tilted facet normals on Voronoi cells.
+    FacetBump,
+    /// A sparse map over another (`Overlay`): the glitter map.
+    GlitterOverlay,
+    /// A `Switch` with a stochastic `blend` band.
+    StochasticSwitch,
+    /// Light transmitted into a translucent body and volume scattering (later work).
+    Transmission,
+    /// Spectral rendering (later work; colours are RGB today).
+    Spectral,
+    /// Fluorescence, course §5.2.2 (later work).
+    Fluorescence,
+    /// Thin-lens depth of field (a camera `aperture > 0`).
+    DepthOfField,
+    /// Importance sampling of an environment map.
+    EnvironmentImportance,
+}
+
+impl Effect {
+    /// Every effect, in a fixed order.
+    pub const ALL: [Effect; 10] = [
+        Effect::Absorption,
+        Effect::TTerm,
+        Effect::FacetBump,
+        Effect::GlitterOverlay,
+        Effect::StochasticSwitch,
+        Effect::Transmission,
+        Effect::Spectral,
+        Effect::Fluorescence,
+        Effect::DepthOfField,
+        Effect::EnvironmentImportance,
+    ];
+
+    /// Short name, as printed and as used by `--effect` toggles.
+    pub fn name(self) -> &'static str {
+        match self {
+            Effect::Absorption => "absorption",
+            Effect::TTerm => "t-term",
+            Effect::FacetBump => "facet-bump",
+            Effect::GlitterOverlay => "glitter-overlay",
+            Effect::StochasticSwitch => "stochastic-switch",
+            Effect::Transmission => "transmission",
+            Effect::Spectral => "spectral",
+            Effect::Fluorescence => "fluorescence",
+            Effect::DepthOfField => "depth-of-field",
+            Effect::EnvironmentImportance => "environment-importance",
+        }
+    }
+
+    /// Whether this version can simulate the effect at all (the others are slots for later work:
+    /// no recipe element turns them on yet).
+    pub fn implemented(self) -> bool {
+        !matches!(
+            self,
+            Effect::Transmission | Effect::Spectral | Effect::Fluorescence
+        )
+    }
+
+    /// What turns the effect on.
+    pub fn trigger(self) -> &'static str {
+        match self {
+            Effect::Absorption => "a used material with a coat of thickness > 0 and absorption/tint",
+            Effect::TTerm => "a used coated material evaluated with the t term (Course model, or t_term: true)",
+            Effect::FacetBump => "a Voronoi map with `bump`",
+            Effect::GlitterOverlay => "an Overlay node",
+            Effect::StochasticSwitch => "a Switch with blend > 0",
+            Effect::Transmission => "a translucent body (not in this version)",
+            Effect::Spectral => "spectral colours (not in this version)",
+            Effect::Fluorescence => "a fluorescent material (not in this version)",
+            Effect::DepthOfField => "a perspective camera with aperture > 0",
+            Effect::EnvironmentImportance => "an environment Map (EXR)",
+        }
+    }
+
+    fn bit(self) -> u32 {
+        1 << self as u8
+    }
+}
+
+impl fmt::Display for Effect {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// The effects a scene needs, each with the first recipe element that turned it on and how many
+/// elements call for it.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Effects {
+    bits: u32,
+    reasons: Vec<(Effect, String, usize)>,
+}
+
+impl Effects {
+    /// Records that `element` (e.g. `material "glitter_1" coats[0]`) calls for `effect`.
+    pub fn turn_on(&mut self, effect: Effect, element: impl Into<String>) {
+        self.bits |= effect.bit();
+        match self.reasons.iter_mut().find(|(e, _, _)| *e == effect) {
+            Some((_, _, n)) => *n += 1,
+            None => self.reasons.push((effect, element.into(), 1)),
+        }
+    }
+
+    /// Whether the scene needs `effect` (the hot-path test: one bit).
+    #[inline]
+    pub fn on(&self, effect: Effect) -> bool {
+        self.bits & effect.bit() != 0
+    }
+
+    /// The first element that turned `effect` on and the number of elements that call for it.
+    pub fn reason(&self, effect: Effect) -> Option<(&str, usize)> {
+        self.reasons
+            .iter()
+            .find(|(e, _, _)| *e == effect)
+            .map(|(_, s, n)| (s.as_str(), *n))
+    }
+
+    /// The effects that are on, in [`Effect::ALL`] order.
+    pub fn iter(&self) -> impl Iterator<Item = Effect> + '_ {
+        Effect::ALL.into_iter().filter(|e| self.on(*e))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bits_and_reasons() {
+        let mut fx = Effects::default();
+        assert!(Effect::ALL.iter().all(|e| !fx.on(*e)));
+        fx.turn_on(Effect::FacetBump, "surface.over.bump");
+        fx.turn_on(Effect::FacetBump, "maps.\"x\".bump");
+        fx.turn_on(Effect::Absorption, "material \"a\" coats[0]");
+        assert!(fx.on(Effect::FacetBump) && fx.on(Effect::Absorption) && !fx.on(Effect::TTerm));
+        assert_eq!(fx.reason(Effect::FacetBump), Some(("surface.over.bump", 2)));
+        assert_eq!(
+            fx.iter().collect::<Vec<_>>(),
+            [Effect::Absorption, Effect::FacetBump]
+        );
+        let names: std::collections::HashSet<_> = Effect::ALL.iter().map(|e| e.name()).collect();
+        assert_eq!(names.len(), Effect::ALL.len());
+    }
+}

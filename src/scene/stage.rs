@@ -1,0 +1,359 @@
+//! The runtime stage: the stone's shape and placement, the ground, environment, lights, camera and
+//! render settings, resolved (studio defaults filled in, directions normalised, colours linear).
+//!
+//! World space is right-handed, y up; lengths in object units; angles stored in radians.
+
+use crate::color::Spectrum;
+use glam::{Affine3A, EulerRot, Quat, Vec3};
+use std::path::PathBuf;
+
+/// The stone's shape in object space.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Shape {
+    /// A sphere of `radius` centred at the origin.
+    Sphere {
+        /// Radius.
+        radius: f32,
+    },
+    /// Half-ellipsoid dome of semi-axes (`radius.0`, `height`, `radius.1`) above y = 0 over a flat
+    /// base (`base = 0`) or a lower half-ellipsoid of depth `base`.
+    Cabochon {
+        /// Semi-axes along x and z.
+        radius: (f32, f32),
+        /// Dome height.
+        height: f32,
+        /// Lower dome depth (0: flat).
+        base: f32,
+    },
+    /// A box of full sizes `size`, centred on the y axis, resting on y = 0.
+    Slab {
+        /// Full sizes along x, y, z.
+        size: Vec3,
+    },
+    /// A triangle mesh to be loaded from an OBJ file.
+    Mesh {
+        /// Resolved path of the file.
+        path: PathBuf,
+        /// Uniform scale of its coordinates.
+        scale: f32,
+    },
+}
+
+/// The floor, an infinite Lambertian plane y = `height`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ground {
+    /// Height of the plane.
+    pub height: f32,
+    /// Reflectance.
+    pub albedo: Spectrum,
+}
+
+/// Light from infinitely far away.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Environment {
+    /// The same radiance everywhere.
+    Constant(Spectrum),
+    /// Linear in the direction's y between zenith, horizon and nadir.
+    Gradient {
+        /// At +y.
+        zenith: Spectrum,
+        /// At y = 0.
+        horizon: Spectrum,
+        /// At −y.
+        nadir: Spectrum,
+    },
+    /// A lat-long EXR map.
+    Map {
+        /// Resolved path of the file.
+        path: PathBuf,
+        /// Radiance multiplier.
+        intensity: f32,
+        /// Rotation about +y in radians.
+        rotate: f32,
+    },
+}
+
+impl Environment {
+    /// Whether the environment emits nothing.
+    pub fn is_black(&self) -> bool {
+        match self {
+            Environment::Constant(c) => c.is_black(),
+            Environment::Gradient {
+                zenith,
+                horizon,
+                nadir,
+            } => zenith.is_black() && horizon.is_black() && nadir.is_black(),
+            Environment::Map { intensity, .. } => *intensity == 0.0,
+        }
+    }
+}
+
+/// The shape of an area light.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LightShape {
+    /// A rectangle with half-edge vectors `u` and `v` (`u × v` is the facing normal).
+    Rect {
+        /// Half of the first edge.
+        u: Vec3,
+        /// Half of the second edge.
+        v: Vec3,
+    },
+    /// A disc.
+    Disc {
+        /// Radius.
+        radius: f32,
+    },
+}
+
+/// An area light.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AreaLight {
+    /// Centre.
+    pub center: Vec3,
+    /// Unit normal of the emitting face (towards the target).
+    pub normal: Vec3,
+    /// Its outline.
+    pub shape: LightShape,
+    /// Emitted radiance (colour × intensity).
+    pub radiance: Spectrum,
+    /// Emits from both faces.
+    pub two_sided: bool,
+}
+
+/// The camera projection.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Projection {
+    /// Perspective with a thin lens.
+    Perspective {
+        /// Vertical field of view in radians.
+        fov: f32,
+        /// Lens radius (0: pinhole).
+        aperture: f32,
+        /// Distance of the plane in focus.
+        focus_distance: f32,
+    },
+    /// Parallel projection.
+    Orthographic {
+        /// View height in object units.
+        height: f32,
+    },
+}
+
+/// The camera: an orthonormal frame at `from` looking along `forward`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    /// Eye position.
+    pub from: Vec3,
+    /// Unit view direction.
+    pub forward: Vec3,
+    /// Unit up direction, orthogonal to `forward`.
+    pub up: Vec3,
+    /// Unit right direction (`forward × up`).
+    pub right: Vec3,
+    /// The projection.
+    pub projection: Projection,
+}
+
+impl Camera {
+    /// A camera at `from` looking at `to`; `None` if `to = from` or `up` is parallel to the view.
+    pub fn look_at(from: Vec3, to: Vec3, up: Vec3, projection: Projection) -> Option<Camera> {
+        let forward = (to - from).try_normalize()?;
+        let right = forward.cross(up).try_normalize()?;
+        let up = right.cross(forward);
+        Some(Camera {
+            from,
+            forward,
+            up,
+            right,
+            projection,
+        })
+    }
+}
+
+/// How pixel samples are generated.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SamplerKind {
+    /// Independent hashed uniforms.
+    Independent,
+    /// Owen-scrambled Sobol'.
+    Sobol,
+}
+
+/// Pixel reconstruction filter.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Filter {
+    /// The pixel's own square.
+    Box,
+    /// Truncated Gaussian, σ = radius / 3 pixels.
+    Gaussian {
+        /// Support radius in pixels.
+        radius: f32,
+    },
+}
+
+/// Render settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RenderSettings {
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// Samples per pixel.
+    pub spp: u32,
+    /// Longest path in bounces.
+    pub max_depth: u32,
+    /// The sampler.
+    pub sampler: SamplerKind,
+    /// The pixel filter.
+    pub filter: Filter,
+    /// PNG exposure in stops.
+    pub exposure: f32,
+    /// Seed of the pixel samples.
+    pub seed: u64,
+}
+
+/// A resolved stage.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Stage {
+    /// The stone's shape in object space.
+    pub shape: Shape,
+    /// Object to world.
+    pub to_world: Affine3A,
+    /// The floor, if any.
+    pub ground: Option<Ground>,
+    /// The environment.
+    pub environment: Environment,
+    /// Area lights.
+    pub lights: Vec<AreaLight>,
+    /// The camera.
+    pub camera: Camera,
+    /// Render settings.
+    pub render: RenderSettings,
+}
+
+/// A rectangular soft box at `center` facing `target`, `w × h`, its `w` edge horizontal.
+pub fn rect_light(center: Vec3, target: Vec3, size: (f32, f32), radiance: Spectrum) -> AreaLight {
+    let normal = (target - center).try_normalize().unwrap_or(Vec3::NEG_Y);
+    let side = normal
+        .cross(Vec3::Y)
+        .try_normalize()
+        .unwrap_or_else(|| normal.cross(Vec3::X).normalize());
+    let other = side.cross(normal);
+    // u × v must be the facing normal: side × other = −normal, so swap.
+    let (u, v) = (other * (0.5 * size.1), side * (0.5 * size.0));
+    AreaLight {
+        center,
+        normal,
+        shape: LightShape::Rect { u, v },
+        radiance,
+        two_sided: false,
+    }
+}
+
+/// Object-to-world from a scale, x-y-z rotation angles in degrees and a translation.
+pub fn placement(scale: f32, rotate_deg: Vec3, translate: Vec3) -> Affine3A {
+    let r = rotate_deg * (std::f32::consts::PI / 180.0);
+    Affine3A::from_scale_rotation_translation(
+        Vec3::splat(scale),
+        Quat::from_euler(EulerRot::ZYX, r.z, r.y, r.x),
+        translate,
+    )
+}
+
+impl Stage {
+    /// The built-in studio: an elliptical cabochon (2 × 1.6 units, 0.55 high) on a grey floor,
+    /// three soft boxes (key upper left, fill right, rim behind), a dim sky gradient and a camera
+    /// looking down at 30°.
+    pub fn studio() -> Stage {
+        let camera = Camera::look_at(
+            Vec3::new(0.0, 2.6, 4.2),
+            Vec3::new(0.0, 0.15, 0.0),
+            Vec3::Y,
+            Projection::Perspective {
+                fov: 30f32.to_radians(),
+                aperture: 0.0,
+                focus_distance: Vec3::new(0.0, 2.45, 4.2).length(),
+            },
+        )
+        .expect("the studio camera is well defined");
+        let origin = Vec3::new(0.0, 0.3, 0.0);
+        Stage {
+            shape: Shape::Cabochon {
+                radius: (1.0, 0.8),
+                height: 0.55,
+                base: 0.0,
+            },
+            to_world: Affine3A::IDENTITY,
+            ground: Some(Ground {
+                height: 0.0,
+                albedo: Spectrum::splat(0.3),
+            }),
+            environment: Environment::Gradient {
+                zenith: Spectrum::splat(0.08),
+                horizon: Spectrum::splat(0.05),
+                nadir: Spectrum::splat(0.02),
+            },
+            lights: vec![
+                rect_light(
+                    Vec3::new(-2.5, 4.0, 2.0),
+                    origin,
+                    (3.0, 2.0),
+                    Spectrum::splat(4.0),
+                ),
+                rect_light(
+                    Vec3::new(3.5, 2.5, 1.5),
+                    origin,
+                    (2.0, 2.0),
+                    Spectrum::splat(1.5),
+                ),
+                rect_light(
+                    Vec3::new(0.0, 3.0, -3.5),
+                    origin,
+                    (4.0, 1.0),
+                    Spectrum::splat(3.0),
+                ),
+            ],
+            camera,
+            render: RenderSettings {
+                width: 480,
+                height: 360,
+                spp: 64,
+                max_depth: 8,
+                sampler: SamplerKind::Sobol,
+                filter: Filter::Gaussian { radius: 1.5 },
+                exposure: 0.0,
+                seed: 0,
+            },
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rect_lights_face_their_target_and_span_their_size() {
+        let l = rect_light(Vec3::new(1.0, 3.0, 2.0), Vec3::ZERO, (3.0, 2.0), Spectrum::ONE);
+        let LightShape::Rect { u, v } = l.shape else {
+            panic!()
+        };
+        assert!((u.cross(v).normalize() - l.normal).length() < 1e-5);
+        assert!((2.0 * v.length() - 3.0).abs() < 1e-5 && (2.0 * u.length() - 2.0).abs() < 1e-5);
+        assert!(l.normal.dot(-l.center) > 0.0);
+        // Straight down: no NaN from the parallel up vector.
+        let d = rect_light(Vec3::Y, Vec3::ZERO, (1.0, 1.0), Spectrum::ONE);
+        let LightShape::Rect { u, v } = d.shape else {
+            panic!()
+        };
+        assert!(u.is_finite() && v.is_finite() && u.cross(v).dot(Vec3::NEG_Y) > 0.0);
+    }
+
+    #[test]
+    fn studio_camera_is_orthonormal() {
+        let c = Stage::studio().camera;
+        assert!(c.forward.dot(c.up).abs() < 1e-6 && c.forward.dot(c.right).abs() < 1e-6);
+        assert!(c.up.y > 0.0);
+        assert!(Camera::look_at(Vec3::ZERO, Vec3::Y, Vec3::Y, c.projection).is_none());
+    }
+}
