@@ -2,6 +2,8 @@
 //! lives in its own file.
 
 pub mod brdf;
+pub mod check;
+pub mod info;
 pub mod map;
 pub mod plot;
 
@@ -27,6 +29,12 @@ pub enum Command {
     /// Draw a gem recipe's map tree on a plane (flat colour per material, glitter cells outlined,
     /// facet tilt shaded) to a PNG, and print each material's share of the plane.
     Map(map::MapArgs),
+    /// Check gem recipes and material libraries: syntax, includes, materials, map tree, stage.
+    /// Prints every error as file:line:col and exits with 1 if any file has one.
+    Check(check::CheckArgs),
+    /// Describe a gem recipe: materials and their shares of the stone, map statistics, the stage,
+    /// and every effect with the recipe element that turned it on.
+    Info(info::InfoArgs),
 }
 
 /// Parses the process arguments and runs; errors are printed as `error: …` and exit with 1.
@@ -35,6 +43,12 @@ pub fn run() -> ExitCode {
     let result = match cli.command {
         Command::Brdf(args) => brdf::run(&args),
         Command::Map(args) => map::run(&args),
+        Command::Info(args) => info::run(&args),
+        Command::Check(args) => match check::run(&args) {
+            Ok(true) => Ok(()),
+            Ok(false) => return ExitCode::from(1),
+            Err(e) => Err(e),
+        },
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

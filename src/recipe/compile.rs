@@ -127,7 +127,11 @@ impl<'a> Compiler<'a> {
 
     /// Effects a used material calls for.
     fn stack_effects(&mut self, name: &str, stack: &StackDesc) {
-        let file = self.recipe.library.file_of(name).unwrap_or("?").to_string();
+        let file = self
+            .recipe
+            .library
+            .position_of(name)
+            .unwrap_or_else(|| "?".into());
         for (i, c) in stack.coats.iter().enumerate() {
             if c.thickness > 0.0 && c.absorption.max_channel() > 0.0 {
                 self.effects.turn_on(

@@ -253,6 +253,16 @@ impl MaterialLibrary {
             .map(|(_, s)| self.sources[*s].file.as_str())
     }
 
+    /// Where material `name` is defined, as `file:line:col`.
+    pub fn position_of(&self, name: &str) -> Option<String> {
+        let (_, s) = self.materials.get(name)?;
+        let source = &self.sources[*s];
+        let (line, col) = source
+            .key(name)
+            .map_or((0, 0), |p| super::source::line_col(&source.text, p));
+        Some(format!("{}:{line}:{col}", source.file))
+    }
+
     /// The index of `name` (root materials first, then included ones), if defined.
     pub fn index_of(&self, name: &str) -> Option<usize> {
         self.materials.get_index_of(name)

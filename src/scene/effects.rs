@@ -78,9 +78,9 @@ impl Effect {
             Effect::FacetBump => "a Voronoi map with `bump`",
             Effect::GlitterOverlay => "an Overlay node",
             Effect::StochasticSwitch => "a Switch with blend > 0",
-            Effect::Transmission => "a translucent body (not in this version)",
-            Effect::Spectral => "spectral colours (not in this version)",
-            Effect::Fluorescence => "a fluorescent material (not in this version)",
+            Effect::Transmission => "a translucent body",
+            Effect::Spectral => "spectral colours",
+            Effect::Fluorescence => "a fluorescent material",
             Effect::DepthOfField => "a perspective camera with aperture > 0",
             Effect::EnvironmentImportance => "an environment Map (EXR)",
         }
