@@ -225,7 +225,7 @@ mod tests {
 
     #[test]
     fn shipped_gems_compile_and_use_every_material() {
-        for (name, materials, depth) in [("lepidolite.ron", 20, 3), ("sunstone.ron", 5, 1)] {
+        for (name, materials, depth) in [("lepidolite.ron", 20, 3), ("sunstone.ron", 5, 1), ("sunstone-pink.ron", 4, 1), ("sunstone-patterned.ron", 4, 1), ("green-aventurine.ron", 12, 2), ("raspberry-aventurine.ron", 12, 2), ("aventurine-glass.ron", 10, 2)] {
             let s = gem(name).compile().unwrap_or_else(|e| panic!("{e}")).surface;
             assert_eq!(s.names.len(), materials, "{name}");
             assert_eq!(
