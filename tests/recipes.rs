@@ -1,0 +1,123 @@
+//! Compiling gem recipes: determinism of the runtime tables, the effects set and what turns each
+//! effect on, stage overrides over the studio, included materials.
+
+use lapidary::recipe::GemRecipe;
+use lapidary::scene::stage::{Environment, Projection, Shape};
+use lapidary::scene::{Effect, Scene};
+use std::path::Path;
+
+fn shipped() -> Vec<std::path::PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("gems");
+    let mut v: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "ron"))
+        .collect();
+    v.sort();
+    v
+}
+
+fn compile(text: &str) -> Scene {
+    GemRecipe::parse("t.ron", text)
+        .and_then(|r| r.compile())
+        .unwrap_or_else(|e| panic!("{e}"))
+}
+
+#[test]
+fn compiling_twice_gives_identical_tables() {
+    let gems = shipped();
+    assert_eq!(gems.len(), 7, "{gems:?}");
+    let mut hashes = vec![];
+    for path in gems {
+        let a = GemRecipe::load(&path).unwrap().compile().unwrap();
+        let b = GemRecipe::load(&path).unwrap().compile().unwrap();
+        assert_eq!(a, b, "{}", path.display());
+        hashes.push(a.hash);
+    }
+    hashes.sort_unstable();
+    hashes.dedup();
+    assert_eq!(hashes.len(), 7, "every recipe hashes differently");
+}
+
+#[test]
+fn effects_follow_what_the_recipe_uses() {
+    const M: &str = r#"materials: {
+        "plain": (coats: [(ior: 1.5, roughness: 2.0)], base: Lambert(albedo: Gray(0.5))),
+        "tinted": (coats: [(ior: 1.5, roughness: 2.0, thickness: 1.0, tint: Gray(0.5))],
+                   base: Lambert(albedo: Gray(0.5))),
+        "course": (coats: [(ior: 1.5, roughness: 2.0)], base: Lambert(albedo: Gray(0.5)), model: Course),
+    },"#;
+    // Only "plain" is used: nothing is on, whatever the unused materials would need.
+    let s = compile(&format!("({M} surface: Material(\"plain\"))"));
+    assert_eq!(s.effects.iter().count(), 0, "{:?}", s.effects);
+    assert_eq!(s.surface.unused().collect::<Vec<_>>(), ["tinted", "course"]);
+
+    let s = compile(&format!("({M} surface: Material(\"tinted\"))"));
+    let (why, _) = s.effects.reason(Effect::Absorption).unwrap();
+    assert!(why.contains("\"tinted\" coats[0]") && why.contains("t.ron:3:"), "{why}");
+    assert!(!s.effects.on(Effect::TTerm));
+
+    let s = compile(&format!(
+        "({M} surface: Switch(by: Perlin(scale: 1.0), stops: [(0.0, Material(\"plain\")), (0.5, Material(\"course\"))], blend: 0.1))"
+    ));
+    assert!(s.effects.on(Effect::TTerm) && s.effects.on(Effect::StochasticSwitch));
+    assert!(!s.effects.on(Effect::FacetBump) && !s.effects.on(Effect::GlitterOverlay));
+    // blend 0: a hard switch is no stochastic switch.
+    let s = compile(&format!(
+        "({M} surface: Switch(by: Perlin(scale: 1.0), stops: [(0.0, Material(\"plain\")), (0.5, Material(\"course\"))]))"
+    ));
+    assert!(!s.effects.on(Effect::StochasticSwitch));
+    // A zero-degree bump tilts nothing.
+    let s = compile(&format!(
+        "({M} surface: Voronoi(scale: 0.1, entries: [(1.0, Material(\"plain\"))], bump: Cone(half_angle: 0.0)))"
+    ));
+    assert!(!s.effects.on(Effect::FacetBump));
+}
+
+#[test]
+fn the_stage_overrides_the_studio_part_by_part() {
+    let dir = std::env::temp_dir().join(format!("lapidary-stage-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("sky.exr"), b"not read at compile time").unwrap();
+    let recipe = dir.join("g.ron");
+    std::fs::write(
+        &recipe,
+        r#"(materials: { "a": (base: Lambert(albedo: Gray(0.5))) }, surface: Material("a"),
+           stage: (shape: Sphere(radius: 0.8),
+                   environment: Map(file: "sky.exr", intensity: 2.0),
+                   camera: Perspective(from: (0.0, 1.0, 5.0), to: (0.0, 0.0, 0.0), aperture: 0.05),
+                   render: (spp: 16)))"#,
+    )
+    .unwrap();
+    let s = GemRecipe::load(&recipe).unwrap().compile().unwrap();
+    let studio = lapidary::scene::Stage::studio();
+    assert_eq!(s.stage.shape, Shape::Sphere { radius: 0.8 });
+    assert!(matches!(s.stage.environment, Environment::Map { intensity: 2.0, .. }));
+    assert_eq!(s.stage.lights, studio.lights, "lights not given: the studio's");
+    assert_eq!(s.stage.render.spp, 16);
+    assert_eq!(s.stage.render.width, studio.render.width);
+    let Projection::Perspective { focus_distance, .. } = s.stage.camera.projection else {
+        panic!()
+    };
+    assert!((focus_distance - 26f32.sqrt()).abs() < 1e-5);
+    assert!(s.effects.on(Effect::DepthOfField) && s.effects.on(Effect::EnvironmentImportance));
+    // The studio itself turns neither on.
+    let plain = compile(r#"(materials: { "a": (base: Lambert(albedo: Gray(0.5))) }, surface: Material("a"))"#);
+    assert!(!plain.effects.on(Effect::DepthOfField));
+    assert!(!plain.effects.on(Effect::EnvironmentImportance));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn included_materials_follow_the_recipes_own_in_first_use_order() {
+    let course = Path::new(env!("CARGO_MANIFEST_DIR")).join("materials/course.ron");
+    let text = format!(
+        r#"(include: [{:?}], materials: {{ "own": (base: Lambert(albedo: Gray(0.5))) }},
+           surface: Voronoi(scale: 0.1, entries: [(1.0, Material("brass")), (1.0, Material("own")), (1.0, Material("sugar"))]))"#,
+        course.display().to_string()
+    );
+    let s = compile(&text);
+    assert_eq!(s.surface.names, ["own", "brass", "sugar"]);
+    assert!(s.surface.used.iter().all(|u| *u));
+    assert!(s.effects.on(Effect::Absorption), "brass has a tinted varnish");
+}
