@@ -121,3 +121,24 @@ fn included_materials_follow_the_recipes_own_in_first_use_order() {
     assert!(s.surface.used.iter().all(|u| *u));
     assert!(s.effects.on(Effect::Absorption), "brass has a tinted varnish");
 }
+
+#[test]
+fn every_shipped_file_checks_clean() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut files = shipped();
+    for entry in std::fs::read_dir(root.join("materials")).unwrap() {
+        files.push(entry.unwrap().path());
+    }
+    assert!(files.len() >= 8);
+    for path in files {
+        let report = lapidary::cli::check::check_file(&path);
+        assert!(
+            report.errors.is_empty() && report.warnings.is_empty(),
+            "{}: {:?} {:?}",
+            path.display(),
+            report.errors,
+            report.warnings
+        );
+        assert!(report.summary.contains("materials"), "{}", report.summary);
+    }
+}
