@@ -182,8 +182,16 @@ impl<'a> Compiler<'a> {
                 "{at}: maps nest more than {MAX_NESTING} levels deep, too deep to evaluate"
             );
             if !self.errors.iter().any(|e| e.message.contains("too deep")) {
-                let pos = self.recipe.source.find(&["surface", ":"]);
-                self.errors.push(self.recipe.source.error(pos, message));
+                // At the definition of the innermost named map on the path, else at `surface`.
+                let src = &self.recipe.source;
+                let pos = at
+                    .rsplit("maps.\"")
+                    .next()
+                    .filter(|_| at.contains("maps.\""))
+                    .and_then(|rest| rest.split('"').next())
+                    .and_then(|name| src.key(name))
+                    .or_else(|| src.find(&["surface", ":"]));
+                self.errors.push(src.error(pos, message));
             }
             return self.push(MapNode::Material(0));
         }
@@ -210,11 +218,22 @@ impl<'a> Compiler<'a> {
                 match self.named.get(name) {
                     Some(Some(id)) => return *id,
                     Some(None) => {
-                        self.unknown(
-                            "Map",
-                            name,
-                            format!("map \"{name}\" contains itself (a cycle through `maps`)"),
-                        );
+                        // Point at the use inside the map's own definition (or inside a map it
+                        // uses), which closes the cycle.
+                        let src = &r.source;
+                        let quoted = format!("{name:?}");
+                        let at = src
+                            .key(name)
+                            .and_then(|k| src.find_from(k + 1, &["Map", "(", &quoted]))
+                            .or_else(|| src.find(&["Map", "(", &quoted]));
+                        let key = format!("cycle({name})");
+                        if !self.reported.contains(&key) {
+                            self.reported.push(key);
+                            self.errors.push(src.error(
+                                at,
+                                format!("map \"{name}\" contains itself (a cycle through `maps`)"),
+                            ));
+                        }
                         return self.push(MapNode::Material(0));
                     }
                     None => {}

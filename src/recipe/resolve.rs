@@ -132,7 +132,7 @@ pub(crate) fn stage(
             };
             if (target - center).length() <= 1e-6 * center.length().max(1.0) {
                 errors.push(src.error(
-                    lights_at,
+                    lights_at.and_then(|l| src.nth_element(l, i)).or(lights_at),
                     format!("stage.lights[{i}]: `target` equals `center`; a light must face a point away from itself"),
                 ));
                 continue;

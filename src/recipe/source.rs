@@ -76,14 +76,121 @@ impl Source {
         }
     }
 
-    /// An error from the RON parser.
+    /// An error from the RON parser, moved onto the value it is about: the parser reports type
+    /// errors just after the `:` (on the blank before the value), and checks made once a whole
+    /// tuple or struct was read (`finite3`, a `Switch`'s thresholds) at its closing parenthesis.
     pub fn ron_error(&self, e: &ron::error::SpannedError) -> RecipeError {
+        let message = e.code.to_string();
+        let reported = self.offset(e.span.start.line, e.span.start.col);
+        let mut pos = self.skip_blank(reported);
+        if pos >= self.text.len() {
+            pos = reported; // nothing follows: keep the parser's position
+        }
+        if matches!(e.code, ron::Error::Message(_)) {
+            let before = self.text[..pos].trim_end();
+            let close = if self.text[pos..].starts_with(')') {
+                Some(pos)
+            } else if before.ends_with(')') {
+                Some(before.len() - 1)
+            } else {
+                None
+            };
+            if let Some(open) = close.and_then(|c| self.matching_open(c)) {
+                pos = self.item_start(open);
+                pos = self.refine(pos, &message).unwrap_or(pos);
+            }
+        }
+        let (line, col) = line_col(&self.text, pos);
         RecipeError {
             file: self.file.clone(),
-            line: e.span.start.line,
-            col: e.span.start.col,
-            message: e.code.to_string(),
+            line,
+            col,
+            message,
         }
+    }
+
+    /// Within the item starting at `pos`, the field a check's message names, if it can be found.
+    fn refine(&self, pos: usize, message: &str) -> Option<usize> {
+        if message.contains("blend =") {
+            let key = self.find_from(pos, &["blend", ":"])?;
+            let colon = key + self.text[key..].find(':')?;
+            return Some(self.skip_blank(colon + 1));
+        }
+        // "… but stops[i] = … ≥ stops[j] = …": the later, out-of-order stop.
+        let j = message
+            .rsplit("stops[")
+            .next()
+            .filter(|_| message.contains("strictly ascending") || message.contains("not finite"))
+            .and_then(|r| r.split(']').next())
+            .and_then(|n| n.parse::<usize>().ok())?;
+        let stops = self.find_from(pos, &["stops", ":"])?;
+        self.nth_element(stops, j)
+    }
+
+    /// Byte offset of 1-based `line` and character column `col`.
+    fn offset(&self, line: usize, col: usize) -> usize {
+        let start: usize = self
+            .text
+            .split_inclusive('\n')
+            .take(line.saturating_sub(1))
+            .map(str::len)
+            .sum();
+        let rest = &self.text[start.min(self.text.len())..];
+        start
+            + rest
+                .char_indices()
+                .nth(col.saturating_sub(1))
+                .map_or(rest.len(), |(i, _)| i)
+    }
+
+    /// The first byte at or after `pos` that is neither blank nor inside a comment.
+    fn skip_blank(&self, mut pos: usize) -> usize {
+        while let Some(c) = self.text[pos..].chars().next() {
+            if c.is_whitespace() || self.in_comment(pos) {
+                pos += c.len_utf8();
+            } else {
+                break;
+            }
+        }
+        pos
+    }
+
+    /// The `(` matching the `)` at byte `close`, skipping comments and strings.
+    fn matching_open(&self, close: usize) -> Option<usize> {
+        let bytes = self.text.as_bytes();
+        let mut depth = 0i32;
+        let mut i = close + 1;
+        let mut in_string = false;
+        while i > 0 {
+            i -= 1;
+            if self.in_comment(i) {
+                continue;
+            }
+            match bytes[i] {
+                b'"' if i == 0 || bytes[i - 1] != b'\\' => in_string = !in_string,
+                b')' | b']' | b'}' if !in_string => depth += 1,
+                b'(' | b'[' | b'{' if !in_string => {
+                    depth -= 1;
+                    if depth == 0 {
+                        return Some(i);
+                    }
+                }
+                _ => {}
+            }
+        }
+        None
+    }
+
+    /// The start of the item whose parenthesis opens at `open`: the identifier before it
+    /// (`Switch(`), if any.
+    fn item_start(&self, open: usize) -> usize {
+        let before = &self.text[..open];
+        let ident = before
+            .chars()
+            .rev()
+            .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+            .count();
+        open - ident
     }
 
     fn in_comment(&self, pos: usize) -> bool {
@@ -166,7 +273,7 @@ impl Source {
     }
 
     /// The start of the `i`-th parenthesised element of the list that follows `from`.
-    fn nth_element(&self, from: usize, i: usize) -> Option<usize> {
+    pub(crate) fn nth_element(&self, from: usize, i: usize) -> Option<usize> {
         let mut depth = 0i32;
         let mut count = 0usize;
         for (off, ch) in self.text[from..].char_indices() {
@@ -178,7 +285,7 @@ impl Source {
                     depth += 1;
                     if depth == 2 && ch == '(' {
                         if count == i {
-                            return Some(from + off);
+                            return Some(self.item_start(from + off));
                         }
                         count += 1;
                     }

@@ -1,0 +1,334 @@
+//! A table of malformed gem recipes: each must be rejected by `GemRecipe::check_source` with its
+//! first error at the expected `file:line:col` and a message naming what is wrong (and, for numbers,
+//! the allowed range). Also: several errors in one file, and the
+//! `lapidary check` command line.
+
+use lapidary::recipe::{GemRecipe, RecipeError, Source};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// One malformed recipe and what its first error must say.
+struct Row {
+    name: &'static str,
+    /// File name (suffix) the first error must name.
+    file: &'static str,
+    line: usize,
+    col: usize,
+    /// Substrings the message must contain.
+    msg: &'static [&'static str],
+    text: String,
+}
+
+fn row(name: &'static str, at: (usize, usize), msg: &'static [&'static str], text: String) -> Row {
+    Row {
+        name,
+        file: "bad.ron",
+        line: at.0,
+        col: at.1,
+        msg,
+        text,
+    }
+}
+
+/// Line 1 of most rows: two materials, "a" and "b".
+const M: &str = r#"(materials: { "a": (base: Lambert(albedo: Gray(0.5))), "b": (base: Lambert(albedo: Gray(0.2))) },"#;
+
+/// `M`, then `body` from line 2 (the surface and whatever else), then the closing parenthesis.
+fn gem(body: &str) -> String {
+    format!("{M}\n{body})")
+}
+
+/// A material "c" whose second coat (line 3) is `coat`; the first coat is fine.
+fn coat(coat: &str) -> String {
+    format!(
+        "(materials: {{\n \"c\": (\n  coats: [(ior: 1.5, roughness: 1.0), ({coat})],\n  base: Lambert(albedo: Gray(0.5))),\n}},\n surface: Material(\"c\"))"
+    )
+}
+
+/// A valid surface, then `stage: (` on line 3 with `stage` from line 4.
+fn stage(stage: &str) -> String {
+    gem(&format!(
+        " surface: Material(\"a\"),\n stage: (\n{stage}\n ),\n"
+    ))
+}
+
+/// `n` named maps `m0 → m1 → …`, each a one-stop Switch over the next: nesting far beyond what
+/// the runtime evaluates, while each map is shallow for the RON parser.
+fn deep_switches(n: usize) -> String {
+    let mut maps = String::new();
+    for i in 0..n {
+        let next = if i + 1 == n {
+            "Material(\"a\")".to_string()
+        } else {
+            format!("Map(\"m{}\")", i + 1)
+        };
+        maps += &format!("  \"m{i}\": Switch(by: Constant(0.0), stops: [(0.0, {next})]),\n");
+    }
+    gem(&format!(" maps: {{\n{maps} }},\n surface: Map(\"m0\")"))
+}
+
+/// A sparse glitter Voronoi over `n - 1` nested Voronoi maps, in an Overlay: one lookup visits `n`.
+fn nested_glitter(n: usize) -> String {
+    let mut tree = "Material(\"b\")".to_string();
+    for i in (0..n).rev() {
+        let fill = if i == 0 { 0.1 } else { 1.0 };
+        tree = format!(
+            "Voronoi(scale: 0.{}, fill: {fill}, entries: [(1.0, {tree})])",
+            i + 1
+        );
+    }
+    gem(&format!(
+        " surface: Overlay(under: Material(\"a\"),\n  over: {tree}),\n"
+    ))
+}
+
+fn rows() -> Vec<Row> {
+    let s = |t: &str| t.to_string();
+    #[rustfmt::skip]
+    let rows = vec![
+        // --- Syntax and shape of the file.
+        row("empty_file", (1, 1), &["Expected opening `(`", "GemDesc"], s("")),
+        row("missing_comma", (3, 4), &["Expected comma"], gem(" surface: Voronoi(scale: 0.1\n   fill: 0.5, entries: [(1.0, Material(\"a\"))])")),
+        row("unclosed_paren", (2, 41), &["Expected comma"], s("(materials: {\n \"c\": (coats: [(ior: 1.5, roughness: 1.0], base: Lambert(albedo: Gray(0.5))),\n},\n surface: Material(\"c\"))")),
+        row("unclosed_paren_at_eof", (2, 60), &["Expected comma"], s(M) + "\n surface: Overlay(under: Material(\"a\"), over: Material(\"b\")\n"),
+        row("unknown_top_field", (2, 2), &["`colour`", "`seed`, `include`, `materials`, `maps`, `surface`, or `stage`"], gem(" colour: 1,\n surface: Material(\"a\")")),
+        row("unknown_field_voronoi", (3, 4), &["`size` in `Voronoi`", "`scale`", "`entries`", "`fill`"], gem(" surface: Voronoi(scale: 0.1,\n   size: 2.0, entries: [(1.0, Material(\"a\"))])")),
+        row("unknown_field_coat", (3, 66), &["`colour` in `CoatDesc`", "`ior`", "`tint`"], coat("ior: 1.5, roughness: 1.0, colour: 1")),
+        row("unknown_field_stage", (4, 3), &["`lighting` in `StageDesc`", "`lights`", "`camera`"], stage("  lighting: [],")),
+        row("unknown_field_camera", (5, 4), &["`zoom` in `Perspective`", "`fov`"], stage("  camera: Perspective(from: (0.0, 1.0, 5.0), to: (0.0, 0.0, 0.0),\n   zoom: 2.0),")),
+        row("number_for_string", (3, 18), &["Expected string"], gem(" surface: Overlay(under: Material(\"a\"),\n  over: Material(3))")),
+        row("variant_voronoy", (2, 11), &["`Voronoy`", "`Voronoi`"], gem(" surface: Voronoy(scale: 1.0)")),
+        row("variant_plastic", (3, 9), &["`Plastic`", "`Lambert`", "`Conductor`"], s("(materials: {\n \"c\": (coats: [],\n  base: Plastic(albedo: Gray(0.5))),\n},\n surface: Material(\"c\"))")),
+        // --- Names; a name in a comment never attracts the error.
+        row("unknown_material", (5, 11), &["unknown material \"garnett\"", "did you mean \"garnet\""], s("(materials: {\n \"garnet\": (base: Lambert(albedo: Gray(0.5))),\n},\n // was Material(\"garnett\") before\n surface: Material(\"garnett\"))")),
+        row("unknown_map", (3, 29), &["unknown map \"tile\"", "did you mean \"tiles\""], gem(" maps: { \"tiles\": Voronoi(scale: 0.1, entries: [(1.0, Material(\"a\"))]) },\n /* Map(\"tile\") */ surface: Map(\"tile\")")),
+        // --- Coats and bases (checked after parsing, located at the field in the right coat).
+        row("ior_one", (3, 40), &["material \"c\"", "coats[1].ior = 1 ", "1.0001 ..= 10"], coat("ior: 1.0, roughness: 1.0")),
+        row("ior_half", (3, 56), &["coats[1].ior = 0.5", "1.0001 ..= 10"], coat("roughness: 1.0, ior: 0.5")),
+        row("ior_nan", (3, 40), &["coats[1].ior = NaN", "1.0001 ..= 10"], coat("ior: NaN, roughness: 1.0")),
+        row("roughness_zero", (3, 50), &["coats[1].roughness = 0 ", "0.01 ..< 90"], coat("ior: 1.5, roughness: 0.0")),
+        row("roughness_ninety", (3, 50), &["coats[1].roughness = 90", "0.01 ..< 90"], coat("ior: 1.5, roughness: 90.0")),
+        row("thickness_negative", (3, 66), &["coats[1].thickness = -1", "0 ..= finite"], coat("ior: 1.5, roughness: 1.0, thickness: -1.0")),
+        row("absorption_negative", (3, 82), &["coats[1].absorption[0] = -1", ">= 0"], coat("ior: 1.5, roughness: 1.0, thickness: 1.0, absorption: Rgb(-1.0, 0.0, 0.0)")),
+        row("tint_no_thickness", (3, 66), &["coats[1].tint needs thickness > 0"], coat("ior: 1.5, roughness: 1.0, tint: Gray(0.5)")),
+        row("absorption_and_tint", (3, 39), &["coats[1]", "either `absorption` or `tint`, not both"], coat("ior: 1.5, roughness: 1.0, thickness: 1.0, absorption: Gray(0.1), tint: Gray(0.5)")),
+        row("albedo_nan", (3, 17), &["base.albedo", "must be finite"], s("(materials: {\n \"c\": (coats: [(ior: 1.5, roughness: 1.0)],\n  base: Lambert(albedo: Rgb(0.5, NaN, 0.5))),\n},\n surface: Material(\"c\"))")),
+        row("srgb_above_one", (3, 17), &["base.albedo", "Srgb(1.2, 0.5, 0.5)", "0 ..= 1"], s("(materials: {\n \"c\": (coats: [(ior: 1.5, roughness: 1.0)],\n  base: Lambert(albedo: Srgb(1.2, 0.5, 0.5))),\n},\n surface: Material(\"c\"))")),
+        row("hex_five_digits", (3, 17), &["Hex(\"#12345\")", "#rrggbb"], s("(materials: {\n \"c\": (coats: [(ior: 1.5, roughness: 1.0)],\n  base: Lambert(albedo: Hex(\"#12345\"))),\n},\n surface: Material(\"c\"))")),
+        // --- Map numbers (checked while parsing, located at the number).
+        row("fill_above_one", (3, 10), &["fill = 1.5", "0 ..= 1"], gem(" surface: Voronoi(scale: 0.1,\n   fill: 1.5, entries: [(1.0, Material(\"a\"))])")),
+        row("fill_negative", (3, 10), &["fill = -0.1", "0 ..= 1"], gem(" surface: Voronoi(scale: 0.1,\n   fill: -0.1, entries: [(1.0, Material(\"a\"))])")),
+        row("scale_zero", (3, 11), &["scale = 0 ", "0.0001 ..= 10000"], gem(" surface: Voronoi(entries: [(1.0, Material(\"a\"))],\n   scale: 0.0)")),
+        row("scale_inf", (3, 11), &["scale = inf", "0.0001 ..= 10000"], gem(" surface: Voronoi(entries: [(1.0, Material(\"a\"))],\n   scale: inf)")),
+        row("weight_zero", (3, 5), &["weight = 0 ", "0 <.. 1e6"], gem(" surface: Voronoi(scale: 0.1, entries: [(1.0, Material(\"a\")),\n   (0.0, Material(\"b\"))])")),
+        row("weights_all_zero", (3, 15), &["weight = 0 ", "0 <.. 1e6"], gem(" surface: Voronoi(scale: 0.1,\n   entries: [(0.0, Material(\"a\")), (0.0, Material(\"b\"))])")),
+        row("weight_nan", (2, 42), &["weight = NaN", "0 <.. 1e6"], gem(" surface: Voronoi(scale: 0.1, entries: [(NaN, Material(\"a\"))])")),
+        row("octaves_40", (3, 13), &["octaves = 40", "1 ..= 16"], gem(" surface: Switch(by: Marble(scale: 1.0,\n   octaves: 40), stops: [(0.0, Material(\"a\"))])")),
+        row("jitter_2", (3, 12), &["jitter = 2", "0 ..= 1"], gem(" surface: Voronoi(scale: 0.1,\n   jitter: 2.0, entries: [(1.0, Material(\"a\"))])")),
+        row("cone_95", (3, 27), &["half_angle = 95", "0 ..= 89"], gem(" surface: Voronoi(scale: 0.1, entries: [(1.0, Material(\"a\"))],\n   bump: Cone(half_angle: 95.0))")),
+        // --- Stage (numbers at the number; a tuple or colour at its closing parenthesis).
+        row("spp_zero", (5, 9), &["spp = 0", "1 ..= 1048576"], stage("  render: (width: 64,\n   spp: 0),")),
+        row("width_zero", (5, 11), &["image size = 0", "1 ..= 16384"], stage("  render: (spp: 4,\n   width: 0),")),
+        row("fov_zero", (5, 9), &["fov = 0", "1 ..= 170"], stage("  camera: Perspective(from: (0.0, 1.0, 5.0), to: (0.0, 0.0, 0.0),\n   fov: 0.0),")),
+        row("camera_inf", (5, 10), &["(0.0, inf, 5.0)", "finite"], stage("  camera: Perspective(to: (0.0, 0.0, 0.0),\n   from: (0.0, inf, 5.0)),")),
+        row("camera_nan", (5, 8), &["(NaN, 0.0, 0.0)", "finite"], stage("  camera: Orthographic(from: (0.0, 1.0, 5.0), height: 2.0,\n   to: (NaN, 0.0, 0.0)),")),
+        row("radiance_negative", (5, 14), &["radiance [-1.0, 0.0, 0.0]", "allowed 0 ..="], stage("  lights: [Disc(center: (0.0, 4.0, 0.0), radius: 1.0,\n   radiance: Rgb(-1.0, 0.0, 0.0))],")),
+        row("camera_from_is_to", (5, 3), &["stage.camera", "`to` must differ from `from`"], stage("  render: (spp: 4),\n  camera: Perspective(from: (1.0, 2.0, 3.0), to: (1.0, 2.0, 3.0)),")),
+        row("mesh_missing", (5, 10), &["mesh \"no_such_mesh.obj\"", "no such file"], stage("  shape: Mesh(scale: 2.0,\n   file: \"no_such_mesh.obj\"),")),
+        row("env_map_missing", (5, 10), &["environment map \"no_sky.exr\"", "no such file"], stage("  environment: Map(intensity: 2.0,\n   file: \"no_sky.exr\"),")),
+        // --- Structure.
+        row("transparent_root", (3, 2), &["surface can be transparent", "Overlay"], gem(" maps: {},\n surface: Voronoi(scale: 0.1, fill: 0.5, entries: [(1.0, Material(\"a\"))])")),
+        row("map_cycle", (2, 51), &["map \"x\" contains itself"], gem(" maps: { \"x\": Voronoi(scale: 1.0, entries: [(1.0, Map(\"x\"))]) },\n surface: Map(\"x\"),")),
+        row("glitter_17_voronoi", (2, 2), &["visit 17 Voronoi maps", "at most 16"], nested_glitter(17)),
+        row("include_missing", (4, 4), &["include \"no_such_library.ron\"", "no such file"], gem(" // \"no_such_library.ron\" is missing\n include: [\"lib.ron\",\n   \"no_such_library.ron\"],\n surface: Material(\"from_lib\")")),
+        Row { file: "cycle_b.ron", ..row("include_cycle", (3, 15), &["include \"cycle_a.ron\" makes a cycle", "cycle_a.ron → ", "cycle_b.ron → "], gem(" include: [\"cycle_a.ron\"],\n surface: Material(\"from_b\")")) },
+        Row { file: "dup.ron", ..row("include_duplicate", (4, 9), &["material \"a\" is already defined at bad.ron:1:15", "unique"], gem(" include: [\"dup.ron\"],\n surface: Material(\"a\")")) },
+        // Positions refined after parsing: type errors on the value, checks of a whole Switch on
+        // the stop or blend they reject, a cycle at the use that closes it, nesting at the
+        // definition of the named map where the limit is crossed, a light at its own entry.
+        row("string_for_number", (2, 26), &["Expected float"], gem(" surface: Voronoi(scale: \"big\", entries: [(1.0, Material(\"a\"))])")),
+        row("thresholds_unordered", (4, 6), &["strictly ascending", "stops[0] = 0.5 ≥ stops[1] = 0.2"], gem(" surface: Switch(by: Constant(0.0),\n   stops: [(0.5, Material(\"a\")),\n     (0.2, Material(\"b\"))],\n ")),
+        row("blend_too_wide", (2, 44), &["blend = 0.5", "0 ..= 0.2", "narrowest gap"], gem(" surface: Switch(by: Constant(0.0), blend: 0.5,\n   stops: [(0.0, Material(\"a\")), (0.2, Material(\"b\"))],\n ")),
+        row("map_cycle_used_first", (3, 51), &["map \"x\" contains itself"], gem(" surface: Map(\"x\"),\n maps: { \"x\": Voronoi(scale: 1.0, entries: [(1.0, Map(\"x\"))]) },")),
+        row("nesting_too_deep", (34, 3), &["maps.\"m31\".stops[0]", "nest more than 64 levels", "too deep to evaluate"], deep_switches(70)),
+        row("light_target_is_center", (6, 4), &["stage.lights[1]", "`target` equals `center`"], stage("  lights: [\n   Rect(center: (0.0, 4.0, 0.0), size: (1.0, 1.0), radiance: Gray(1.0)),\n   Disc(center: (1.0, 2.0, 3.0), target: (1.0, 2.0, 3.0), radius: 1.0, radiance: Gray(1.0)),\n  ],")),
+    ];
+    rows
+}
+
+fn fixtures() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/recipe_errors")
+}
+
+/// The first error of `row`, or a description of what went wrong (no error, a panic).
+fn first_error(row: &Row) -> Result<RecipeError, String> {
+    let path = fixtures().join("bad.ron");
+    let text = row.text.clone();
+    let report = std::panic::catch_unwind(move || {
+        GemRecipe::check_source(Source::new("bad.ron", &text), Some(&path))
+    })
+    .map_err(|_| "check_source panicked".to_string())?;
+    report
+        .errors
+        .into_iter()
+        .next()
+        .ok_or_else(|| "no error reported".to_string())
+}
+
+/// Checks every row; returns one readable paragraph per failing row.
+fn check_rows(rows: &[Row]) -> Vec<String> {
+    let mut failures = vec![];
+    for row in rows {
+        let problem = match first_error(row) {
+            Err(e) => Some((e, String::new())),
+            Ok(e) => {
+                let mut wrong = vec![];
+                if (e.line, e.col) != (row.line, row.col) {
+                    wrong.push(format!(
+                        "position: got {}:{}, expected {}:{}",
+                        e.line, e.col, row.line, row.col
+                    ));
+                }
+                if !e.file.ends_with(row.file) {
+                    wrong.push(format!("file: got {:?}, expected …{}", e.file, row.file));
+                }
+                for m in row.msg.iter().filter(|m| !e.message.contains(*m)) {
+                    wrong.push(format!("message lacks {m:?}"));
+                }
+                (!wrong.is_empty()).then(|| (wrong.join("; "), e.to_string()))
+            }
+        };
+        if let Some((what, shown)) = problem {
+            failures.push(format!(
+                "[{}] {what}\n    error: {shown}\n    recipe:\n{}",
+                row.name,
+                row.text
+                    .lines()
+                    .enumerate()
+                    .map(|(i, l)| format!("    {:>3}| {l}", i + 1))
+                    .collect::<Vec<_>>()
+                    .join("\n")
+            ));
+        }
+    }
+    failures
+}
+
+#[test]
+fn malformed_recipes_point_at_the_problem() {
+    let rows = rows();
+    assert!(rows.len() >= 30, "{} rows", rows.len());
+    let failures = check_rows(&rows);
+    assert!(
+        failures.is_empty(),
+        "{} of {} rows failed:\n{}",
+        failures.len(),
+        rows.len(),
+        failures.join("\n")
+    );
+}
+
+/// Every error of `many_errors.ron`: an include, a coat and two names, each at its own position.
+#[test]
+fn one_check_reports_every_error() {
+    let path = fixtures().join("many_errors.ron");
+    let source = Source::read(&path).expect("the fixture is readable");
+    let report = GemRecipe::check_source(source, Some(&path));
+    let expected: [(usize, usize, &[&str]); 4] = [
+        (3, 15, &["include \"missing_library.ron\"", "no such file"]),
+        (
+            7,
+            48,
+            &[
+                "material \"bad_coat\"",
+                "coats[0].thickness = -2",
+                "0 ..= finite",
+            ],
+        ),
+        (
+            15,
+            19,
+            &["unknown material \"bodyy\"", "did you mean \"body\""],
+        ),
+        (17, 19, &["unknown material \"glitter\""]),
+    ];
+    let all: Vec<String> = report.errors.iter().map(|e| e.to_string()).collect();
+    assert!(report.errors.len() >= 4, "{all:#?}");
+    assert!(report.scene.is_none());
+    for (line, col, msg) in expected {
+        assert!(
+            report.errors.iter().any(|e| (e.line, e.col) == (line, col)
+                && e.file.ends_with("many_errors.ron")
+                && msg.iter().all(|m| e.message.contains(m))),
+            "no error at {line}:{col} saying {msg:?}; got {all:#?}"
+        );
+    }
+    let mut at: Vec<(usize, usize)> = report.errors.iter().map(|e| (e.line, e.col)).collect();
+    at.sort();
+    at.dedup();
+    assert_eq!(
+        at.len(),
+        report.errors.len(),
+        "positions not distinct: {all:#?}"
+    );
+    assert!(at.iter().all(|&(l, _)| l > 0), "{all:#?}");
+}
+
+fn lapidary_check(files: &[String]) -> (Option<i32>, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_lapidary"))
+        .arg("check")
+        .args(files)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("the binary runs");
+    let text = |b: &[u8]| String::from_utf8_lossy(b).into_owned();
+    (out.status.code(), text(&out.stdout), text(&out.stderr))
+}
+
+#[test]
+fn check_command_prints_positions_and_fails() {
+    let bad = "tests/recipe_errors/many_errors.ron";
+    let good = "gems/sunstone.ron";
+    let (code, stdout, stderr) = lapidary_check(&[bad.into(), good.into()]);
+    let shown = format!("stdout:\n{stdout}\nstderr:\n{stderr}");
+    assert_eq!(code, Some(1), "{shown}");
+    for at in [
+        "3:15: include",
+        "7:48: material",
+        "15:19: unknown",
+        "17:19: unknown",
+    ] {
+        assert!(
+            stderr.contains(&format!("error: {bad}:{at}")),
+            "{at}\n{shown}"
+        );
+    }
+    let errors = stderr.lines().filter(|l| l.starts_with("error: ")).count();
+    assert!(errors >= 4, "{shown}");
+    assert!(stdout.contains(&format!("{good}: ok")), "{shown}");
+    assert!(!stdout.contains(&format!("{bad}: ok")), "{shown}");
+}
+
+#[test]
+fn check_command_accepts_every_shipped_file() {
+    let mut files: Vec<String> =
+        std::fs::read_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join("gems"))
+            .expect("gems/ is readable")
+            .map(|e| {
+                e.expect("a directory entry")
+                    .file_name()
+                    .to_string_lossy()
+                    .into_owned()
+            })
+            .filter(|n| n.ends_with(".ron"))
+            .map(|n| format!("gems/{n}"))
+            .collect();
+    files.sort();
+    assert!(files.len() >= 2, "{files:?}");
+    files.push("materials/course.ron".into());
+    let (code, stdout, stderr) = lapidary_check(&files);
+    assert_eq!(code, Some(0), "stdout:\n{stdout}\nstderr:\n{stderr}");
+    for f in &files {
+        assert!(stdout.contains(&format!("{f}: ok")), "{f}\n{stdout}");
+    }
+}
