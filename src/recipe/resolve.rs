@@ -199,7 +199,11 @@ pub(crate) fn stage(
             Some(c) => stage.camera = c,
             None => errors.push(src.error(
                 part_at("camera"),
-                "stage.camera: `to` must differ from `from`, and `up` must not be parallel to the view direction",
+                if (to - from).length() <= 1e-6 * from.length().max(1.0) {
+                    format!("stage.camera: `to` = {to} equals `from`; the camera must look at a point away from itself")
+                } else {
+                    format!("stage.camera: `up` = {up} is parallel to the view direction {}; give an up vector across it", (to - from).normalize())
+                },
             )),
         }
     }

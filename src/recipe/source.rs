@@ -100,6 +100,23 @@ impl Source {
                 pos = self.refine(pos, &message).unwrap_or(pos);
             }
         }
+        let mut message = message;
+        if message.starts_with("Expected") && pos < self.text.len() {
+            // Say what was found instead.
+            let token: String = self.text[pos..]
+                .chars()
+                .take_while(|c| !matches!(c, ',' | ')' | ']' | '}' | '\n'))
+                .take(40)
+                .collect();
+            if !token.trim().is_empty() {
+                message += &format!(", found `{}`", token.trim());
+            }
+        }
+        if let Some(open) = self.unclosed() {
+            let (l, c) = line_col(&self.text, open);
+            let ch = &self.text[open..=open];
+            message += &format!(" (note: the `{ch}` at {l}:{c} is never closed)");
+        }
         let (line, col) = line_col(&self.text, pos);
         RecipeError {
             file: self.file.clone(),
@@ -107,6 +124,34 @@ impl Source {
             col,
             message,
         }
+    }
+
+    /// The last bracket left open at the end of the text, if the brackets do not balance.
+    fn unclosed(&self) -> Option<usize> {
+        let b = self.text.as_bytes();
+        let mut stack = vec![];
+        let mut i = 0;
+        while i < b.len() {
+            if self.in_comment(i) {
+                i += 1;
+                continue;
+            }
+            match b[i] {
+                b'"' => {
+                    i += 1;
+                    while i < b.len() && b[i] != b'"' {
+                        i += if b[i] == b'\\' { 2 } else { 1 };
+                    }
+                }
+                b'(' | b'[' | b'{' => stack.push(i),
+                b')' | b']' | b'}' => {
+                    stack.pop()?;
+                }
+                _ => {}
+            }
+            i += 1;
+        }
+        stack.pop()
     }
 
     /// Within the item starting at `pos`, the field a check's message names, if it can be found.
