@@ -143,6 +143,8 @@ fn rows() -> Vec<Row> {
         row("include_missing", (4, 4), &["include \"no_such_library.ron\"", "no such file"], gem(" // \"no_such_library.ron\" is missing\n include: [\"lib.ron\",\n   \"no_such_library.ron\"],\n surface: Material(\"from_lib\")")),
         Row { file: "cycle_b.ron", ..row("include_cycle", (3, 15), &["include \"cycle_a.ron\" makes a cycle", "cycle_a.ron → ", "cycle_b.ron → "], gem(" include: [\"cycle_a.ron\"],\n surface: Material(\"from_b\")")) },
         Row { file: "dup.ron", ..row("include_duplicate", (4, 9), &["material \"a\" is already defined at bad.ron:1:15", "unique"], gem(" include: [\"dup.ron\"],\n surface: Material(\"a\")")) },
+        row("duplicate_material_key", (3, 3), &["\"a\" is defined twice", "unique"], s("(materials: {\n \"a\": (base: Lambert(albedo: Gray(0.5))),\n \"a\": (base: Lambert(albedo: Gray(0.2))),\n},\n surface: Material(\"a\"))")),
+        row("unknown_material_in_unused_map", (2, 55), &["unknown material \"c\""], gem(" maps: { \"spare\": Voronoi(scale: 0.1, entries: [(1.0, Material(\"c\"))]) },\n surface: Material(\"a\"),")),
         // Positions refined after parsing: type errors on the value, checks of a whole Switch on
         // the stop or blend they reject, a cycle at the use that closes it, nesting at the
         // definition of the named map where the limit is crossed, a light at its own entry.

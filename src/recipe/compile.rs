@@ -61,10 +61,33 @@ impl<'a> Compiler<'a> {
     }
 
     /// Compiles everything, appending errors to `errors`; the scene when none were found.
-    pub(crate) fn run(mut self, errors: &mut Vec<RecipeError>) -> Option<Scene> {
+    pub(crate) fn run(
+        mut self,
+        errors: &mut Vec<RecipeError>,
+        warnings: &mut Vec<RecipeError>,
+    ) -> Option<Scene> {
         let r = self.recipe;
         let own = r.content.materials.len();
         let root = self.node(&r.content.surface, "surface");
+        // Named maps the tree never reaches are still checked (in a scratch compiler, so the
+        // scene's tables and default seeds are those of the tree alone), and reported unused.
+        for (name, sub) in &r.content.maps {
+            if !self.named.contains_key(name) {
+                let mut scratch = Compiler::new(r);
+                scratch.named = self.named.clone();
+                scratch.named.insert(name.clone(), None);
+                scratch.node(sub, &format!("maps.{name:?}"));
+                for e in scratch.errors {
+                    if !self.errors.contains(&e) {
+                        self.errors.push(e);
+                    }
+                }
+                warnings.push(r.source.error(
+                    r.source.key(name),
+                    format!("map \"{name}\" is defined but the surface never uses it"),
+                ));
+            }
+        }
         let mut used = vec![false; self.materials.len()];
         let (nodes, entries, stops, fields) = (
             std::mem::take(&mut self.nodes),

@@ -59,10 +59,10 @@ pub struct GemDesc {
     #[serde(default)]
     pub include: Vec<String>,
     /// The recipe's own layered materials by name, in file order.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "super::ranged::unique_keys")]
     pub materials: IndexMap<String, MaterialDesc>,
     /// Named sub-maps, usable as `Map("name")` anywhere in the tree.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "super::ranged::unique_keys")]
     pub maps: IndexMap<String, MapDesc>,
     /// The surface map tree.
     pub surface: MapDesc,
@@ -191,7 +191,7 @@ impl GemRecipe {
         errors: &mut Vec<RecipeError>,
         warnings: &mut Vec<RecipeError>,
     ) -> Option<Scene> {
-        let scene = Compiler::new(self).run(errors);
+        let scene = Compiler::new(self).run(errors, warnings);
         if let Some(scene) = &scene {
             for name in scene.surface.unused() {
                 warnings.push(self.source.error(

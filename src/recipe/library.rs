@@ -33,7 +33,7 @@ pub struct MaterialFile {
     #[serde(default)]
     pub include: Vec<String>,
     /// Materials in file order.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "super::ranged::unique_keys")]
     pub materials: IndexMap<String, MaterialDesc>,
 }
 

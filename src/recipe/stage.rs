@@ -150,6 +150,9 @@ fn one() -> f32 {
 fn thirty() -> f32 {
     30.0
 }
+fn one_and_a_half() -> f32 {
+    1.5
+}
 fn grey_half() -> ColorDesc {
     ColorDesc::Gray(0.5)
 }
@@ -181,7 +184,9 @@ pub struct StageDesc {
     pub render: RenderDesc,
 }
 
-/// The stone's shape, in object space (base on the plane y = 0, centred on the y axis).
+/// The stone's shape, in object space: a cabochon and a slab rest on the plane y = 0, centred on
+/// the y axis; a sphere is centred at the origin (lift it with `transform`); a mesh keeps its file's
+/// coordinates.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum ShapeDesc {
@@ -402,7 +407,7 @@ pub enum FilterDesc {
     /// A truncated Gaussian of standard deviation `radius / 3` pixels.
     Gaussian {
         /// Support radius in pixels, 0.5 ..= 4 (default 1.5).
-        #[serde(deserialize_with = "filter_radius_range")]
+        #[serde(default = "one_and_a_half", deserialize_with = "filter_radius_range")]
         radius: f32,
     },
 }
