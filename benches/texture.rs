@@ -256,7 +256,11 @@ fn two_level() -> Map {
 fn lepidolite() -> Map {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/gems/lepidolite.ron");
     let recipe = GemRecipe::load(path.as_ref()).unwrap_or_else(|e| panic!("{e}"));
-    recipe.compile().unwrap_or_else(|e| panic!("{e}")).surface.map
+    recipe
+        .compile()
+        .unwrap_or_else(|e| panic!("{e}"))
+        .surface
+        .map
 }
 
 /// Whole map lookups (material, facet normal, cell trail).

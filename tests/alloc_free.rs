@@ -38,7 +38,12 @@ static ALLOCATOR: Counting = Counting;
 fn lookups_of_the_shipped_gems_do_not_allocate() {
     for gem in ["lepidolite.ron", "sunstone.ron"] {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("gems").join(gem);
-        let map = GemRecipe::load(&path).unwrap().compile().unwrap().surface.map;
+        let map = GemRecipe::load(&path)
+            .unwrap()
+            .compile()
+            .unwrap()
+            .surface
+            .map;
         let mut rng = Rng::new(1);
         let points: Vec<(Vec3, f32)> = (0..20_000)
             .map(|_| {

@@ -54,7 +54,10 @@ fn effects_follow_what_the_recipe_uses() {
 
     let s = compile(&format!("({M} surface: Material(\"tinted\"))"));
     let (why, _) = s.effects.reason(Effect::Absorption).unwrap();
-    assert!(why.contains("\"tinted\" coats[0]") && why.contains("t.ron:3:"), "{why}");
+    assert!(
+        why.contains("\"tinted\" coats[0]") && why.contains("t.ron:3:"),
+        "{why}"
+    );
     assert!(!s.effects.on(Effect::TTerm));
 
     let s = compile(&format!(
@@ -92,8 +95,14 @@ fn the_stage_overrides_the_studio_part_by_part() {
     let s = GemRecipe::load(&recipe).unwrap().compile().unwrap();
     let studio = lapidary::scene::Stage::studio();
     assert_eq!(s.stage.shape, Shape::Sphere { radius: 0.8 });
-    assert!(matches!(s.stage.environment, Environment::Map { intensity: 2.0, .. }));
-    assert_eq!(s.stage.lights, studio.lights, "lights not given: the studio's");
+    assert!(matches!(
+        s.stage.environment,
+        Environment::Map { intensity: 2.0, .. }
+    ));
+    assert_eq!(
+        s.stage.lights, studio.lights,
+        "lights not given: the studio's"
+    );
     assert_eq!(s.stage.render.spp, 16);
     assert_eq!(s.stage.render.width, studio.render.width);
     let Projection::Perspective { focus_distance, .. } = s.stage.camera.projection else {
@@ -102,7 +111,9 @@ fn the_stage_overrides_the_studio_part_by_part() {
     assert!((focus_distance - 26f32.sqrt()).abs() < 1e-5);
     assert!(s.effects.on(Effect::DepthOfField) && s.effects.on(Effect::EnvironmentImportance));
     // The studio itself turns neither on.
-    let plain = compile(r#"(materials: { "a": (base: Lambert(albedo: Gray(0.5))) }, surface: Material("a"))"#);
+    let plain = compile(
+        r#"(materials: { "a": (base: Lambert(albedo: Gray(0.5))) }, surface: Material("a"))"#,
+    );
     assert!(!plain.effects.on(Effect::DepthOfField));
     assert!(!plain.effects.on(Effect::EnvironmentImportance));
     let _ = std::fs::remove_dir_all(&dir);
@@ -119,7 +130,10 @@ fn included_materials_follow_the_recipes_own_in_first_use_order() {
     let s = compile(&text);
     assert_eq!(s.surface.names, ["own", "brass", "sugar"]);
     assert!(s.surface.used.iter().all(|u| *u));
-    assert!(s.effects.on(Effect::Absorption), "brass has a tinted varnish");
+    assert!(
+        s.effects.on(Effect::Absorption),
+        "brass has a tinted varnish"
+    );
 }
 
 #[test]

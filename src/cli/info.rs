@@ -111,8 +111,8 @@ pub fn describe(recipe: &GemRecipe, scene: &Scene, points: u32) -> String {
     let width = s.names.iter().map(|n| n.len()).max().unwrap_or(4).max(4);
     let _ = writeln!(
         o,
-        "  {:>3}  {:<width$}  {:>7}  {:<10}  {:<28}  {}",
-        "id", "name", "share", "model", "coats", "base  [file]"
+        "  {:>3}  {:<width$}  {:>7}  {:<10}  {:<28}  base  [file]",
+        "id", "name", "share", "model", "coats"
     );
     for (i, name) in s.names.iter().enumerate() {
         let (coats, base) = stack_summary(&s.stacks[i]);
@@ -240,7 +240,9 @@ pub fn describe(recipe: &GemRecipe, scene: &Scene, points: u32) -> String {
     let _ = writeln!(o, "  environment  {env}");
     for (i, l) in st.lights.iter().enumerate() {
         let shape = match l.shape {
-            LightShape::Rect { u, v } => format!("rect {:.2} × {:.2}", 2.0 * v.length(), 2.0 * u.length()),
+            LightShape::Rect { u, v } => {
+                format!("rect {:.2} × {:.2}", 2.0 * v.length(), 2.0 * u.length())
+            }
             LightShape::Disc { radius } => format!("disc r {radius:.2}"),
         };
         let _ = writeln!(

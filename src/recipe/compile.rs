@@ -105,7 +105,8 @@ impl<'a> Compiler<'a> {
             Err(e) => {
                 if self.errors.is_empty() {
                     let at = r.source.find(&["surface", ":"]);
-                    self.errors.push(r.source.error(at, format!("surface: {e}")));
+                    self.errors
+                        .push(r.source.error(at, format!("surface: {e}")));
                 }
                 None
             }
@@ -140,7 +141,11 @@ impl<'a> Compiler<'a> {
                 names,
                 stacks,
                 map,
-                used: used.iter().enumerate().map(|(i, u)| *u || i >= own).collect(),
+                used: used
+                    .iter()
+                    .enumerate()
+                    .map(|(i, u)| *u || i >= own)
+                    .collect(),
             },
             stage,
             effects: self.effects,
@@ -445,7 +450,8 @@ impl<'a> Compiler<'a> {
             Err(e) => {
                 // Unreachable for parsed input (children are added first); keep it an error.
                 let r = self.recipe;
-                self.errors.push(r.source.error(None, format!("internal: {e}")));
+                self.errors
+                    .push(r.source.error(None, format!("internal: {e}")));
                 0
             }
         }

@@ -225,8 +225,19 @@ mod tests {
 
     #[test]
     fn shipped_gems_compile_and_use_every_material() {
-        for (name, materials, depth) in [("lepidolite.ron", 20, 3), ("sunstone.ron", 5, 1), ("sunstone-pink.ron", 4, 1), ("sunstone-patterned.ron", 4, 1), ("green-aventurine.ron", 12, 2), ("raspberry-aventurine.ron", 12, 2), ("aventurine-glass.ron", 10, 2)] {
-            let s = gem(name).compile().unwrap_or_else(|e| panic!("{e}")).surface;
+        for (name, materials, depth) in [
+            ("lepidolite.ron", 20, 3),
+            ("sunstone.ron", 5, 1),
+            ("sunstone-pink.ron", 4, 1),
+            ("sunstone-patterned.ron", 4, 1),
+            ("green-aventurine.ron", 12, 2),
+            ("raspberry-aventurine.ron", 12, 2),
+            ("aventurine-glass.ron", 10, 2),
+        ] {
+            let s = gem(name)
+                .compile()
+                .unwrap_or_else(|e| panic!("{e}"))
+                .surface;
             assert_eq!(s.names.len(), materials, "{name}");
             assert_eq!(
                 s.unused().count(),
@@ -315,9 +326,21 @@ mod tests {
                 "(seed: {seed}, {MATS}\n surface: Voronoi(scale: 0.1, entries: [(1.0, Material(\"a\")), (1.0, Material(\"b\"))]))"
             )
         };
-        let a = GemRecipe::parse("g", &src(0)).unwrap().compile().unwrap().surface;
-        let b = GemRecipe::parse("g", &src(1)).unwrap().compile().unwrap().surface;
-        let a2 = GemRecipe::parse("g", &src(0)).unwrap().compile().unwrap().surface;
+        let a = GemRecipe::parse("g", &src(0))
+            .unwrap()
+            .compile()
+            .unwrap()
+            .surface;
+        let b = GemRecipe::parse("g", &src(1))
+            .unwrap()
+            .compile()
+            .unwrap()
+            .surface;
+        let a2 = GemRecipe::parse("g", &src(0))
+            .unwrap()
+            .compile()
+            .unwrap()
+            .surface;
         let mut differ = 0;
         for i in 0..200 {
             let p = Vec3::new(i as f32 * 0.137, 0.3, -0.2);

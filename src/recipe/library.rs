@@ -189,7 +189,14 @@ impl MaterialLibrary {
             self.sources.push(source);
             let index = self.sources.len() - 1;
             chain.push(canonical);
-            self.include(index, Some(&target), &content.include, chain, loaded, errors);
+            self.include(
+                index,
+                Some(&target),
+                &content.include,
+                chain,
+                loaded,
+                errors,
+            );
             chain.pop();
             for (key, desc) in content.materials {
                 if let Some((_, earlier)) = self.materials.get(&key) {
@@ -376,8 +383,16 @@ mod tests {
         assert_eq!(lib.names().collect::<Vec<_>>(), ["a", "b"]);
         assert!(lib.file_of("b").unwrap().ends_with("b.ron"));
         assert_eq!(errors.len(), 2, "{errors:?}");
-        assert!(errors[0].message.contains("cycle") && errors[0].line == 1, "{}", errors[0]);
-        assert!(errors[0].file.ends_with("b.ron") && errors[0].col == 12, "{}", errors[0]);
+        assert!(
+            errors[0].message.contains("cycle") && errors[0].line == 1,
+            "{}",
+            errors[0]
+        );
+        assert!(
+            errors[0].file.ends_with("b.ron") && errors[0].col == 12,
+            "{}",
+            errors[0]
+        );
         assert!(errors[1].message.contains("no such file"), "{}", errors[1]);
 
         write(
@@ -389,7 +404,10 @@ mod tests {
             .iter()
             .find(|e| e.message.contains("already defined"))
             .expect("duplicate reported");
-        assert!(dup.file.ends_with("b.ron") && dup.message.contains("d.ron:2:"), "{dup}");
+        assert!(
+            dup.file.ends_with("b.ron") && dup.message.contains("d.ron:2:"),
+            "{dup}"
+        );
         let _ = std::fs::remove_dir_all(&dir);
     }
 }

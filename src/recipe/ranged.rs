@@ -33,7 +33,6 @@ macro_rules! ranged {
     };
 }
 
-
 /// Deserializes a name → value map, rejecting a name given twice (a plain map would keep the
 /// later one silently).
 pub(crate) fn unique_keys<'de, D, V>(d: D) -> Result<indexmap::IndexMap<String, V>, D::Error>
@@ -47,7 +46,10 @@ where
         fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
             f.write_str("a map from names to definitions")
         }
-        fn visit_map<A: serde::de::MapAccess<'de>>(self, mut m: A) -> Result<Self::Value, A::Error> {
+        fn visit_map<A: serde::de::MapAccess<'de>>(
+            self,
+            mut m: A,
+        ) -> Result<Self::Value, A::Error> {
             let mut out = indexmap::IndexMap::new();
             while let Some(key) = m.next_key::<String>()? {
                 if out.contains_key(&key) {

@@ -44,10 +44,7 @@ pub(crate) fn stage(
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case(ext));
         if !ok_ext {
-            errors.push(src.error(
-                at,
-                format!("{what} \"{name}\": expected a .{ext} file"),
-            ));
+            errors.push(src.error(at, format!("{what} \"{name}\": expected a .{ext} file")));
             None
         } else if !path.is_file() {
             errors.push(src.error(

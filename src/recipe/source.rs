@@ -42,7 +42,8 @@ impl Source {
             col: 0,
             message,
         };
-        let meta = std::fs::metadata(path).map_err(|e| fail(format!("cannot read the file: {e}")))?;
+        let meta =
+            std::fs::metadata(path).map_err(|e| fail(format!("cannot read the file: {e}")))?;
         if !meta.is_file() {
             return Err(fail("not a regular file".into()));
         }
@@ -416,7 +417,10 @@ pub(crate) fn line_col(source: &str, pos: usize) -> (usize, usize) {
 }
 
 fn line_col_bytes(bytes: &[u8], pos: usize) -> (usize, usize) {
-    line_col(&String::from_utf8_lossy(&bytes[..pos.min(bytes.len())]), pos)
+    line_col(
+        &String::from_utf8_lossy(&bytes[..pos.min(bytes.len())]),
+        pos,
+    )
 }
 
 #[cfg(test)]
@@ -433,7 +437,11 @@ mod tests {
         assert_eq!(line_col(&s.text, at), (2, 47));
         assert_eq!(s.find_all(&["Material", "(", "\"a\""]).len(), 1);
         // Identifiers stand alone.
-        assert!(Source::new("x", "MaterialX(\"a\")").find(&["Material"]).is_none());
+        assert!(
+            Source::new("x", "MaterialX(\"a\")")
+                .find(&["Material"])
+                .is_none()
+        );
     }
 
     #[test]

@@ -73,8 +73,12 @@ impl Effect {
     /// What turns the effect on.
     pub fn trigger(self) -> &'static str {
         match self {
-            Effect::Absorption => "a used material with a coat of thickness > 0 and absorption/tint",
-            Effect::TTerm => "a used coated material evaluated with the t term (Course model, or t_term: true)",
+            Effect::Absorption => {
+                "a used material with a coat of thickness > 0 and absorption/tint"
+            }
+            Effect::TTerm => {
+                "a used coated material evaluated with the t term (Course model, or t_term: true)"
+            }
             Effect::FacetBump => "a Voronoi map with `bump`",
             Effect::GlitterOverlay => "an Overlay node",
             Effect::StochasticSwitch => "a Switch with blend > 0",

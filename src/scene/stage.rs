@@ -334,7 +334,12 @@ mod tests {
 
     #[test]
     fn rect_lights_face_their_target_and_span_their_size() {
-        let l = rect_light(Vec3::new(1.0, 3.0, 2.0), Vec3::ZERO, (3.0, 2.0), Spectrum::ONE);
+        let l = rect_light(
+            Vec3::new(1.0, 3.0, 2.0),
+            Vec3::ZERO,
+            (3.0, 2.0),
+            Spectrum::ONE,
+        );
         let LightShape::Rect { u, v } = l.shape else {
             panic!()
         };
