@@ -53,7 +53,17 @@ impl Source {
                 meta.len()
             )));
         }
-        let bytes = std::fs::read(path).map_err(|e| fail(format!("cannot read the file: {e}")))?;
+        if meta.len() == 0 {
+            // Nothing to read (and never read pseudo-files such as /proc/kmsg, which report size
+            // 0 and can block).
+            return Ok(Source::new(&file, ""));
+        }
+        let mut bytes = Vec::with_capacity(meta.len() as usize);
+        std::fs::File::open(path)
+            .and_then(|f| {
+                std::io::Read::read_to_end(&mut std::io::Read::take(f, MAX_FILE_BYTES), &mut bytes)
+            })
+            .map_err(|e| fail(format!("cannot read the file: {e}")))?;
         let text = String::from_utf8(bytes).map_err(|e| {
             let (line, col) = line_col_bytes(e.as_bytes(), e.utf8_error().valid_up_to());
             RecipeError {
