@@ -9,7 +9,6 @@
 //! The longer run (10× the cases):
 //! `cargo test --release --test fuzz_recipes -- --ignored --nocapture`
 
-use lapidary::recipe::{GemRecipe, MaterialLibrary, Source};
 use std::cell::RefCell;
 use std::panic::{self, AssertUnwindSafe};
 use std::path::Path;
@@ -19,31 +18,9 @@ const SEED: u64 = 0x1a91_da7e_5eed;
 /// Cases of the short run (about 10–20 s in the test profile).
 const CASES: usize = 40_000;
 
-/// The fuzz target's checks (kept identical to `fuzz/fuzz_targets/recipe.rs`); whether a scene
-/// came back.
+/// The fuzz target's checks (`lapidary::recipe::exercise`); whether a scene came back.
 fn check(text: &str) -> bool {
-    let report = GemRecipe::check_source(Source::new("fuzz.ron", text), None);
-    let _ = MaterialLibrary::parse("fuzz.ron", text);
-    let Some(scene) = report.scene else {
-        return false;
-    };
-    let hit = scene
-        .surface
-        .map
-        .lookup(glam::Vec3::new(0.3, 0.1, -0.2), 0.5);
-    assert!(
-        (hit.material as usize) < scene.surface.names.len(),
-        "material index {} out of {} materials",
-        hit.material,
-        scene.surface.names.len()
-    );
-    let again = GemRecipe::check_source(Source::new("fuzz.ron", text), None);
-    assert_eq!(
-        again.scene.as_ref(),
-        Some(&scene),
-        "compiling twice differs"
-    );
-    true
+    lapidary::recipe::exercise(text)
 }
 
 /// splitmix64.

@@ -83,3 +83,33 @@ pub fn did_you_mean<'a>(name: &str, known: impl Iterator<Item = &'a str>) -> Opt
         .min_by_key(|(d, _)| *d)
         .map(|(_, k)| k)
 }
+
+/// Runs `text` through everything a description file goes through — checked as a gem recipe
+/// (parse, includes relative to the working directory, every material, compile, stage) and parsed
+/// as a material library — then looks a point up in the compiled scene and compiles it a second
+/// time. Returns whether a scene came out. Any panic here is a bug: this is what the fuzz target
+/// (`fuzz/`) and the seeded fuzz test (`tests/fuzz_recipes.rs`) run on their inputs.
+pub fn exercise(text: &str) -> bool {
+    let report = GemRecipe::check_source(Source::new("fuzz.ron", text), None);
+    let _ = MaterialLibrary::parse("fuzz.ron", text);
+    let Some(scene) = report.scene else {
+        return false;
+    };
+    let hit = scene
+        .surface
+        .map
+        .lookup(glam::Vec3::new(0.3, 0.1, -0.2), 0.5);
+    assert!(
+        (hit.material as usize) < scene.surface.names.len(),
+        "material index {} out of {} materials",
+        hit.material,
+        scene.surface.names.len()
+    );
+    let again = GemRecipe::check_source(Source::new("fuzz.ron", text), None);
+    assert_eq!(
+        again.scene.as_ref(),
+        Some(&scene),
+        "compiling twice differs"
+    );
+    true
+}

@@ -65,3 +65,29 @@ where
     }
     d.deserialize_map(Visit(std::marker::PhantomData))
 }
+
+/// A finite `f32`.
+pub(crate) fn finite<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f32, D::Error> {
+    let v = <f32 as serde::Deserialize>::deserialize(d)?;
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(serde::de::Error::custom(format!(
+            "{v} must be a finite number"
+        )))
+    }
+}
+
+/// Sizes (each `0 <.. 1e4`), given as a tuple's components.
+pub(crate) fn sizes_ok<E: serde::de::Error>(
+    v: &[f32],
+    shown: impl std::fmt::Debug,
+) -> Result<(), E> {
+    if v.iter().all(|x| *x > 0.0 && *x <= 1e4) {
+        Ok(())
+    } else {
+        Err(E::custom(format!(
+            "{shown:?} is out of range: each size allowed 0 <.. 1e4"
+        )))
+    }
+}

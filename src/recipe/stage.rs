@@ -19,6 +19,7 @@
 //! ```
 
 use super::color::ColorDesc;
+use super::ranged::{finite, sizes_ok};
 use serde::{Deserialize, Deserializer, Serialize};
 
 ranged!(length_range, "length", open 0.0, 1e4);
@@ -44,24 +45,12 @@ fn finite3<'de, D: Deserializer<'de>>(d: D) -> Result<V3, D::Error> {
 
 fn positive2<'de, D: Deserializer<'de>>(d: D) -> Result<(f32, f32), D::Error> {
     let v = <(f32, f32)>::deserialize(d)?;
-    if [v.0, v.1].iter().all(|x| *x > 0.0 && *x <= 1e4) {
-        Ok(v)
-    } else {
-        Err(serde::de::Error::custom(format!(
-            "{v:?} is out of range: each size allowed 0 <.. 1e4"
-        )))
-    }
+    sizes_ok(&[v.0, v.1], v).map(|()| v)
 }
 
 fn positive3<'de, D: Deserializer<'de>>(d: D) -> Result<V3, D::Error> {
     let v = V3::deserialize(d)?;
-    if [v.0, v.1, v.2].iter().all(|x| *x > 0.0 && *x <= 1e4) {
-        Ok(v)
-    } else {
-        Err(serde::de::Error::custom(format!(
-            "{v:?} is out of range: each size allowed 0 <.. 1e4"
-        )))
-    }
+    sizes_ok(&[v.0, v.1, v.2], v).map(|()| v)
 }
 
 fn base_range<'de, D: Deserializer<'de>>(d: D) -> Result<f32, D::Error> {
@@ -71,17 +60,6 @@ fn base_range<'de, D: Deserializer<'de>>(d: D) -> Result<f32, D::Error> {
     } else {
         Err(serde::de::Error::custom(format!(
             "base = {v} is out of range: allowed 0 ..= 1e4 (0: a flat base)"
-        )))
-    }
-}
-
-fn finite<'de, D: Deserializer<'de>>(d: D) -> Result<f32, D::Error> {
-    let v = f32::deserialize(d)?;
-    if v.is_finite() {
-        Ok(v)
-    } else {
-        Err(serde::de::Error::custom(format!(
-            "{v} must be a finite number"
         )))
     }
 }

@@ -19,6 +19,7 @@
 //! Every number is range-checked while it is read, so an error points at the number itself
 //! (`file:line:col`); the allowed ranges are listed in `docs/recipes.md`.
 
+use super::ranged::finite;
 use serde::{Deserialize, Deserializer, Serialize};
 
 ranged!(scale_range, "scale", 1e-4, 1e4);
@@ -50,15 +51,6 @@ fn axis_check<'de, D: Deserializer<'de>>(d: D) -> Result<(f32, f32, f32), D::Err
         Err(serde::de::Error::custom(format!(
             "axis = {v:?} must be a finite, non-zero direction"
         )))
-    }
-}
-
-fn finite<'de, D: Deserializer<'de>>(d: D) -> Result<f32, D::Error> {
-    let v = f32::deserialize(d)?;
-    if v.is_finite() {
-        Ok(v)
-    } else {
-        Err(serde::de::Error::custom(format!("{v} must be finite")))
     }
 }
 
