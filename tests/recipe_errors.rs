@@ -145,6 +145,8 @@ fn rows() -> Vec<Row> {
         Row { file: "dup.ron", ..row("include_duplicate", (4, 9), &["material \"a\" is already defined at bad.ron:1:15", "unique"], gem(" include: [\"dup.ron\"],\n surface: Material(\"a\")")) },
         row("duplicate_material_key", (3, 3), &["\"a\" is defined twice", "unique"], s("(materials: {\n \"a\": (base: Lambert(albedo: Gray(0.5))),\n \"a\": (base: Lambert(albedo: Gray(0.2))),\n},\n surface: Material(\"a\"))")),
         row("unknown_material_in_unused_map", (2, 55), &["unknown material \"c\""], gem(" maps: { \"spare\": Voronoi(scale: 0.1, entries: [(1.0, Material(\"c\"))]) },\n surface: Material(\"a\"),")),
+        row("no_materials_at_all", (1, 26), &["unknown material \"x\""], s("(materials: {}, surface: Material(\"x\"))")),
+        row("no_materials_unknown_map", (1, 26), &["unknown map \"m\""], s("(materials: {}, surface: Map(\"m\"))")),
         // Positions refined after parsing: type errors on the value, checks of a whole Switch on
         // the stop or blend they reject, a cycle at the use that closes it, nesting at the
         // definition of the named map where the limit is crossed, a light at its own entry.

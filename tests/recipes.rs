@@ -156,3 +156,59 @@ fn every_shipped_file_checks_clean() {
         assert!(report.summary.contains("materials"), "{}", report.summary);
     }
 }
+
+#[test]
+fn info_prints_materials_map_statistics_stage_and_effects() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_lapidary"))
+        .arg("info")
+        .arg(root.join("gems/lepidolite.ron"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    for expected in [
+        "materials (20, 20 used)",
+        "dark_silver",
+        "map: 32 nodes (Voronoi 5, Overlay 1, Switch 1, Material 25)",
+        "nesting depth 5 nodes; a lookup visits at most 3 Voronoi cells",
+        "cells/unit",
+        "surface.over ",
+        "stage:",
+        "render       480×360, 64 spp",
+        "on   facet-bump               surface.over.bump = Cone { half_angle: 25.0 }",
+        "on   stochastic-switch",
+        "off  depth-of-field",
+        "off  transmission             slot for later work",
+    ] {
+        assert!(text.contains(expected), "missing {expected:?} in\n{text}");
+    }
+    // Shares of the stone's surface add up to 100 %.
+    let total: f64 = text
+        .lines()
+        .skip_while(|l| !l.starts_with("materials"))
+        .skip(2)
+        .take(20)
+        .map(|l| {
+            let pct = l.split_whitespace().nth(2).unwrap();
+            pct.trim_end_matches('%').parse::<f64>().unwrap()
+        })
+        .sum();
+    assert!((total - 100.0).abs() < 0.2, "{total}");
+    // A recipe with an error: exit 1 and the positioned message.
+    let bad = std::env::temp_dir().join(format!("lapidary-info-{}.ron", std::process::id()));
+    std::fs::write(&bad, "(materials: {}, surface: Material(\"x\"))").unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_lapidary"))
+        .arg("info")
+        .arg(&bad)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains(":1:26: unknown material \"x\""), "{err}");
+    let _ = std::fs::remove_file(&bad);
+}

@@ -96,8 +96,11 @@ impl<'a> Compiler<'a> {
             std::mem::take(&mut self.fields),
         );
         for n in &nodes {
-            if let MapNode::Material(m) = n {
-                used[*m as usize] = true;
+            // Stand-ins for unknown names point at material 0, which need not exist.
+            if let MapNode::Material(m) = n
+                && let Some(u) = used.get_mut(*m as usize)
+            {
+                *u = true;
             }
         }
         let map = match Map::new(nodes, entries, stops, fields, root) {
