@@ -147,6 +147,7 @@ fn rows() -> Vec<Row> {
         row("unknown_material_in_unused_map", (2, 55), &["unknown material \"c\""], gem(" maps: { \"spare\": Voronoi(scale: 0.1, entries: [(1.0, Material(\"c\"))]) },\n surface: Material(\"a\"),")),
         row("no_materials_at_all", (1, 26), &["unknown material \"x\""], s("(materials: {}, surface: Material(\"x\"))")),
         row("no_materials_unknown_map", (1, 26), &["unknown map \"m\""], s("(materials: {}, surface: Map(\"m\"))")),
+        row("unknown_field_in_metal", (2, 79), &["field named `q`", "expected either `n` or `k`"], s("(materials: {\n \"m\": (base: Conductor(metal: Complex(n: (1.0, 1.0, 1.0), k: (1.0, 1.0, 1.0), q: 1.0), roughness: 3.0)),\n},\n surface: Material(\"m\"))")),
         // Positions refined after parsing: type errors on the value, checks of a whole Switch on
         // the stop or blend they reject, a cycle at the use that closes it, nesting at the
         // definition of the named map where the limit is crossed, a light at its own entry.

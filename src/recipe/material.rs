@@ -41,6 +41,7 @@ pub struct CoatDesc {
 
 /// A conductor's optical constants.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum MetalDesc {
     /// Gold (Johnson & Christy 1972).
     Gold,
@@ -97,6 +98,7 @@ fn default_depth() -> u32 {
 
 /// Evaluation model as written in a recipe.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum ModelDesc {
     /// Course eqs. 3.1–3.3 as published.
     Course,
