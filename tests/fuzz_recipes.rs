@@ -23,16 +23,12 @@ fn check(text: &str) -> bool {
     lapidary::recipe::exercise(text)
 }
 
-/// splitmix64.
-struct Rng(u64);
+/// The crate's own counter-based generator, with the picks the mutator needs.
+struct Rng(lapidary::sampler::Rng);
 
 impl Rng {
     fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
+        self.0.next_u64()
     }
     /// Uniform in `0..n` (`n > 0`).
     fn below(&mut self, n: usize) -> usize {
@@ -270,7 +266,9 @@ fn mutate(rng: &mut Rng, bytes: &mut Vec<u8>, seeds: &[String]) {
 
 /// Case `index` of the run seeded `seed`: a mutated shipped file, random bytes or random tokens.
 fn case(seed: u64, index: usize, seeds: &[String]) -> String {
-    let mut rng = Rng(seed ^ (index as u64).wrapping_mul(0xd134_2543_de82_ef95));
+    let mut rng = Rng(lapidary::sampler::Rng::new(
+        seed ^ (index as u64).wrapping_mul(0xd134_2543_de82_ef95),
+    ));
     let bytes = match rng.below(20) {
         0 => (0..rng.below(256)).map(|_| rng.next() as u8).collect(),
         1 | 2 => {

@@ -196,14 +196,16 @@ impl<'a> Compiler<'a> {
 
     /// Reports an unknown name once, at its first use in the file.
     fn unknown(&mut self, kind: &str, name: &str, message: String) {
-        let key = format!("{kind}({name})");
-        if self.reported.contains(&key) {
-            return;
+        let at = self.recipe.source.find(&[kind, "(", &format!("{name:?}")]);
+        self.report_once(format!("{kind}({name})"), at, message);
+    }
+
+    /// Pushes an error unless one with the same `key` was already reported.
+    fn report_once(&mut self, key: String, at: Option<usize>, message: String) {
+        if !self.reported.contains(&key) {
+            self.reported.push(key);
+            self.errors.push(self.recipe.source.error(at, message));
         }
-        self.reported.push(key);
-        let r = self.recipe;
-        let at = r.source.find(&[kind, "(", &format!("{name:?}")]);
-        self.errors.push(r.source.error(at, message));
     }
 
     /// Compiles `desc`, found at tree path `at` (e.g. `surface.over`), into a node.
@@ -257,14 +259,11 @@ impl<'a> Compiler<'a> {
                             .key(name)
                             .and_then(|k| src.find_from(k + 1, &["Map", "(", &quoted]))
                             .or_else(|| src.find(&["Map", "(", &quoted]));
-                        let key = format!("cycle({name})");
-                        if !self.reported.contains(&key) {
-                            self.reported.push(key);
-                            self.errors.push(src.error(
-                                at,
-                                format!("map \"{name}\" contains itself (a cycle through `maps`)"),
-                            ));
-                        }
+                        self.report_once(
+                            format!("cycle({name})"),
+                            at,
+                            format!("map \"{name}\" contains itself (a cycle through `maps`)"),
+                        );
                         return self.push(MapNode::Material(0));
                     }
                     None => {}
