@@ -1,0 +1,1 @@
+//! Light sources: area lights and environments, with sampling for next-event estimation.
