@@ -6,10 +6,13 @@ pub mod check;
 pub mod info;
 pub mod map;
 pub mod plot;
+pub mod render;
 
 use clap::{Parser, Subcommand};
-use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+
+/// Atomic file replacement, shared with the image writers (see [`crate::image::atomic`]).
+pub use crate::image::write_atomically;
 
 /// lapidary — layered BRDFs and procedural gemstones.
 #[derive(Debug, Parser)]
@@ -35,6 +38,9 @@ pub enum Command {
     /// Describe a gem recipe: materials and their shares of the stone, map statistics, the stage,
     /// and every effect with the recipe element that turned it on.
     Info(info::InfoArgs),
+    /// Path-trace a gem recipe to NAME.exr (colour, AOVs, metadata) and NAME.png. Ctrl-C or
+    /// --time-limit stop early and write what was rendered, marked partial (Ctrl-C exits 130).
+    Render(render::RenderArgs),
 }
 
 /// Parses the process arguments and runs; errors are printed as `error: …` and exit with 1.
@@ -44,6 +50,11 @@ pub fn run() -> ExitCode {
         Command::Brdf(args) => brdf::run(&args),
         Command::Map(args) => map::run(&args),
         Command::Info(args) => info::run(&args),
+        Command::Render(args) => match render::run(&args) {
+            Ok(false) => Ok(()),
+            Ok(true) => return ExitCode::from(130),
+            Err(e) => Err(e),
+        },
         Command::Check(args) => match check::run(&args) {
             Ok(true) => Ok(()),
             Ok(false) => return ExitCode::from(1),
@@ -57,37 +68,4 @@ pub fn run() -> ExitCode {
             ExitCode::from(1)
         }
     }
-}
-
-/// Writes a file atomically: `write` fills a temporary file beside `path` (same extension, so
-/// encoders that look at it still work), which then replaces `path` by a rename. A failure leaves
-/// an existing `path` untouched.
-pub fn write_atomically(
-    path: &Path,
-    write: impl FnOnce(&Path) -> anyhow::Result<()>,
-) -> anyhow::Result<()> {
-    let dir = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let name = path
-        .file_name()
-        .ok_or_else(|| anyhow::anyhow!("{}: not a file path", path.display()))?;
-    let ext = path
-        .extension()
-        .map(|e| format!(".{}", e.to_string_lossy()))
-        .unwrap_or_default();
-    let tmp: PathBuf = dir.join(format!(
-        ".{}.{}.tmp{ext}",
-        name.to_string_lossy(),
-        std::process::id()
-    ));
-    let result = write(&tmp).and_then(|()| {
-        std::fs::rename(&tmp, path)
-            .map_err(|e| anyhow::anyhow!("{}: cannot replace: {e}", path.display()))
-    });
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
 }

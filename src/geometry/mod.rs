@@ -1,10 +1,23 @@
 //! Geometry: rays, the stone's shapes and their intersection, shading frames.
 //!
 //! Directions follow the conventions of [`crate::bsdf`]: a frame's `n` is the local `z`, and a
-//! vector in local coordinates has `z = cos θ` to the normal.
+//! vector in local coordinates has `z = cos θ` to the normal. Shapes live in object space
+//! ([`Solid`]); a [`Stone`] places one in the world.
 
+pub mod cabochon;
 pub mod frame;
+pub mod mesh;
 pub mod ray;
+pub mod slab;
+pub mod solid;
+pub mod sphere;
+pub mod stone;
 
+pub use cabochon::Cabochon;
 pub use frame::Frame;
+pub use mesh::Mesh;
 pub use ray::{Ray, offset_origin};
+pub use slab::Slab;
+pub use solid::{GeometryError, ShapeHit, Solid};
+pub use sphere::Sphere;
+pub use stone::{Stone, StoneHit};

@@ -1,1 +1,205 @@
-//! The path tracer.
+//! The path tracer (DESIGN §6): camera rays, pixel filters, the integrator, the film, and the
+//! loop that renders a compiled [`Scene`] in passes of samples over tiles, in parallel.
+//!
+//! **Determinism.** Every random number is `hash(seed, pixel, sample, slot)` ([`PixelSampler`]);
+//! each pixel's samples are added in sample order by the one task that owns its tile in a pass,
+//! and passes run one after another. A render is therefore bit-identical for any thread count and
+//! any tile order.
+//!
+//! **Stopping early.** A cancel flag or a deadline is checked before each tile; tiles not started
+//! are skipped, the render returns what was accumulated and says it is partial. Each pixel's
+//! sample count is kept (the `samples` AOV), so a partial image is still an unbiased mean.
+
+pub mod camera;
+pub mod film;
+pub mod filter;
+pub mod integrator;
+pub mod output;
+pub mod world;
+
+pub use camera::CameraRays;
+pub use film::{Film, PixelSums};
+pub use filter::FilterSampler;
+pub use integrator::{PathSample, Strategy, trace};
+pub use output::{Metadata, exr_image};
+pub use world::{World, WorldError};
+
+use crate::sampler::PixelSampler;
+use crate::scene::stage::{Camera, RenderSettings};
+use glam::Vec2;
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+/// Tile edge in pixels.
+pub const TILE: u32 = 16;
+
+/// How a render is run (not what it renders).
+#[derive(Default)]
+pub struct Control<'a> {
+    /// Worker threads (`None`: rayon's global pool, one per core).
+    pub threads: Option<usize>,
+    /// Direct-light estimators.
+    pub strategy: Strategy,
+    /// Stop starting tiles after this instant.
+    pub deadline: Option<Instant>,
+    /// Stop starting tiles once this is set (Ctrl-C).
+    pub cancel: Option<&'a AtomicBool>,
+    /// Called after each tile with the number of pixel samples it added.
+    pub progress: Option<&'a (dyn Fn(u64) + Sync)>,
+}
+
+/// Figures of a finished (or stopped) render.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RenderStats {
+    /// Wall-clock time.
+    pub elapsed: Duration,
+    /// Camera paths traced (samples kept and dropped).
+    pub paths: u64,
+    /// Rays traced (camera, extension, shadow).
+    pub rays: u64,
+    /// Samples dropped as non-finite.
+    pub dropped: u64,
+    /// Whether the render stopped before every pixel had all its samples.
+    pub partial: bool,
+    /// Samples per pixel every pixel has (equal to the requested count unless partial).
+    pub spp_complete: u32,
+}
+
+/// A rendered film and its figures.
+#[derive(Clone, Debug)]
+pub struct Rendered {
+    /// The accumulated samples.
+    pub film: Film,
+    /// Time, paths, rays, drops.
+    pub stats: RenderStats,
+}
+
+/// Samples per pass: small enough that a stopped render has most pixels at the same count, large
+/// enough that the per-pass overhead vanishes.
+fn pass_size(spp: u32) -> u32 {
+    spp.clamp(1, 4)
+}
+
+/// Renders `world` seen by `camera` with `settings`.
+///
+/// # Arguments
+/// * `world` – the built world ([`World::new`]).
+/// * `camera` – the stage's camera; `depth_of_field` says whether its lens is used.
+/// * `settings` – size, spp, depth, sampler, filter, seed.
+/// * `control` – threads, strategy, early stop, progress.
+pub fn render(
+    world: &World,
+    camera: &Camera,
+    depth_of_field: bool,
+    settings: &RenderSettings,
+    control: &Control,
+) -> Rendered {
+    let start = Instant::now();
+    let run = || render_passes(world, camera, depth_of_field, settings, control);
+    let (film, partial, spp_complete) = match control.threads {
+        Some(n) => match rayon::ThreadPoolBuilder::new()
+            .num_threads(n.max(1))
+            .build()
+        {
+            Ok(pool) => pool.install(run),
+            Err(_) => run(),
+        },
+        None => run(),
+    };
+    let dropped = film.dropped();
+    Rendered {
+        stats: RenderStats {
+            elapsed: start.elapsed(),
+            paths: film.samples() + dropped,
+            rays: film.rays(),
+            dropped,
+            partial,
+            spp_complete,
+        },
+        film,
+    }
+}
+
+fn render_passes(
+    world: &World,
+    camera: &Camera,
+    depth_of_field: bool,
+    settings: &RenderSettings,
+    control: &Control,
+) -> (Film, bool, u32) {
+    let (w, h) = (settings.width, settings.height);
+    let mut film = Film::new(w, h);
+    let rays = CameraRays::new(camera, w, h, depth_of_field);
+    let filter = FilterSampler::new(settings.filter);
+    let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE))
+        .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE)))
+        .collect();
+    let stop = || {
+        control.cancel.is_some_and(|c| c.load(Ordering::Relaxed))
+            || control.deadline.is_some_and(|d| Instant::now() >= d)
+    };
+    let step = pass_size(settings.spp);
+    let mut done = 0;
+    let mut partial = false;
+    while done < settings.spp {
+        let end = (done + step).min(settings.spp);
+        let results: Vec<Option<Vec<PixelSums>>> = tiles
+            .par_iter()
+            .map(|&(x0, y0)| {
+                if stop() {
+                    return None;
+                }
+                let (x1, y1) = ((x0 + TILE).min(w), (y0 + TILE).min(h));
+                let mut sums = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
+                for y in y0..y1 {
+                    for x in x0..x1 {
+                        let mut p = film.pixels[(y * w + x) as usize];
+                        for s in done..end {
+                            let pixel = u64::from(y) * u64::from(w) + u64::from(x);
+                            let mut sampler =
+                                PixelSampler::new(settings.sampler, settings.seed, pixel, s);
+                            let offset = filter.sample(sampler.get2d());
+                            let lens = sampler.get2d();
+                            let film_pt = Vec2::new(x as f32 + 0.5, y as f32 + 0.5) + offset;
+                            let ray = rays.ray(film_pt, lens);
+                            let sample = trace(
+                                world,
+                                ray,
+                                &mut sampler,
+                                settings.max_depth,
+                                control.strategy,
+                            );
+                            p.add(&sample);
+                        }
+                        sums.push(p);
+                    }
+                }
+                if let Some(progress) = control.progress {
+                    progress(sums.len() as u64 * u64::from(end - done));
+                }
+                Some(sums)
+            })
+            .collect();
+        for (&(x0, y0), sums) in tiles.iter().zip(results) {
+            let Some(sums) = sums else {
+                partial = true;
+                continue;
+            };
+            let x1 = (x0 + TILE).min(w);
+            let mut it = sums.into_iter();
+            for y in y0..(y0 + TILE).min(h) {
+                for x in x0..x1 {
+                    if let Some(p) = it.next() {
+                        film.pixels[(y * w + x) as usize] = p;
+                    }
+                }
+            }
+        }
+        if partial {
+            break;
+        }
+        done = end;
+    }
+    (film, partial, done)
+}

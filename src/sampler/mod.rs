@@ -7,6 +7,11 @@
 //! counter-based stream built on it. `rand`'s generators are seeded streams, not keyed hashes of
 //! coordinates, which is why this small piece is our own.
 
+pub mod pixel;
+pub mod sobol;
+
+pub use pixel::{PixelSampler, SamplerKind};
+
 /// SplitMix64's finaliser: a bijective 64-bit mixer with full avalanche.
 #[inline]
 pub fn mix64(mut z: u64) -> u64 {

@@ -170,14 +170,7 @@ impl Camera {
     }
 }
 
-/// How pixel samples are generated.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum SamplerKind {
-    /// Independent hashed uniforms.
-    Independent,
-    /// Owen-scrambled Sobol'.
-    Sobol,
-}
+pub use crate::sampler::SamplerKind;
 
 /// Pixel reconstruction filter.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -1,0 +1,339 @@
+//! `lapidary render RECIPE`: path-trace a gem recipe to an EXR (colour, AOVs, metadata) and a
+//! tone-mapped PNG, with a progress bar and a closing summary. Ctrl-C or `--time-limit` stop the
+//! render cleanly and write what was accumulated, marked partial in the EXR's metadata.
+
+use crate::image::{Curve, ToneMap, write_exr, write_png};
+use crate::recipe::GemRecipe;
+use crate::render::{Control, Metadata, Rendered, Strategy, World, exr_image, render};
+use crate::scene::stage::SamplerKind;
+use crate::scene::{Effect, Scene};
+use anyhow::{Context, Result, anyhow, bail};
+use clap::{Args, ValueEnum};
+use indicatif::{ProgressBar, ProgressStyle};
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+/// Arguments of `lapidary render`.
+#[derive(Debug, Args)]
+pub struct RenderArgs {
+    /// Gem recipe (RON).
+    pub recipe: PathBuf,
+    /// Output EXR (default: the recipe's name with `.exr`, in the current directory).
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+    /// Output PNG (default: the EXR's path with `.png`).
+    #[arg(long)]
+    pub png: Option<PathBuf>,
+    /// Do not write a PNG.
+    #[arg(long, conflicts_with = "png")]
+    pub no_png: bool,
+    /// Samples per pixel (default: the recipe's, else 64).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_048_576))]
+    pub spp: Option<u32>,
+    /// Image size `WxH` in pixels (default: the recipe's, else 480x360).
+    #[arg(long, value_parser = parse_size)]
+    pub size: Option<(u32, u32)>,
+    /// Seed of the pixel samples (default: the recipe's `render.seed`, else 0).
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Worker threads (default: one per core). The image does not depend on it.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub threads: Option<u32>,
+    /// Sample generator (default: the recipe's, else sobol).
+    #[arg(long, value_enum)]
+    pub sampler: Option<SamplerArg>,
+    /// Longest path in scattering events (default: the recipe's, else 8).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub max_depth: Option<u32>,
+    /// Stop after this many seconds and write what was rendered (marked partial).
+    #[arg(long, value_parser = parse_seconds)]
+    pub time_limit: Option<f64>,
+    /// PNG exposure in stops (default: the recipe's, else 0).
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_exposure)]
+    pub exposure: Option<f32>,
+    /// PNG tone curve.
+    #[arg(long, value_enum, default_value_t = CurveArg::Filmic)]
+    pub tonemap: CurveArg,
+    /// Direct-light estimators (for testing the integrator; `mis` is always best).
+    #[arg(long, value_enum, default_value_t = StrategyArg::Mis)]
+    pub strategy: StrategyArg,
+    /// No progress bar and no summary.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+/// `--sampler` values.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum SamplerArg {
+    /// Owen-scrambled Sobol' (best with a power-of-two spp).
+    Sobol,
+    /// Independent hashed uniforms.
+    Independent,
+}
+
+/// `--tonemap` values.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum CurveArg {
+    /// A filmic shoulder that keeps highlights from clipping.
+    Filmic,
+    /// Plain clamp to [0, 1].
+    Clamp,
+}
+
+/// `--strategy` values.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum StrategyArg {
+    /// Light and BSDF sampling with MIS (power heuristic).
+    Mis,
+    /// Light sampling only.
+    Light,
+    /// BSDF sampling only.
+    Bsdf,
+}
+
+fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let err = || format!("`{s}`: expected WxH with each side in 1..=16384, e.g. 480x360");
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(err)?;
+    let (w, h): (u32, u32) = (
+        w.trim().parse().map_err(|_| err())?,
+        h.trim().parse().map_err(|_| err())?,
+    );
+    if !(1..=16384).contains(&w) || !(1..=16384).contains(&h) {
+        return Err(err());
+    }
+    Ok((w, h))
+}
+
+fn parse_seconds(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v > 0.0 && v <= 1e7 => Ok(v),
+        _ => Err(format!("`{s}`: expected seconds in (0, 1e7]")),
+    }
+}
+
+fn parse_exposure(s: &str) -> Result<f32, String> {
+    match s.parse::<f32>() {
+        Ok(v) if (-30.0..=30.0).contains(&v) => Ok(v),
+        _ => Err(format!("`{s}`: expected stops in -30..=30")),
+    }
+}
+
+/// The Ctrl-C flag, installed once per process.
+fn interrupted() -> &'static AtomicBool {
+    static FLAG: OnceLock<&'static AtomicBool> = OnceLock::new();
+    FLAG.get_or_init(|| {
+        let flag: &'static AtomicBool = Box::leak(Box::new(AtomicBool::new(false)));
+        // If a handler cannot be installed, Ctrl-C simply kills the process as usual.
+        let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
+        flag
+    })
+}
+
+/// Where the EXR and PNG go.
+fn outputs(args: &RenderArgs) -> Result<(PathBuf, Option<PathBuf>)> {
+    let exr = match &args.output {
+        Some(p) => p.clone(),
+        None => {
+            let stem = args
+                .recipe
+                .file_stem()
+                .ok_or_else(|| anyhow!("{}: not a file name", args.recipe.display()))?;
+            PathBuf::from(stem).with_extension("exr")
+        }
+    };
+    let png = if args.no_png {
+        None
+    } else {
+        Some(
+            args.png
+                .clone()
+                .unwrap_or_else(|| exr.with_extension("png")),
+        )
+    };
+    for p in std::iter::once(&exr).chain(png.iter()) {
+        let dir = p.parent().filter(|d| !d.as_os_str().is_empty());
+        if let Some(d) = dir
+            && !d.is_dir()
+        {
+            bail!("{}: directory {} does not exist", p.display(), d.display());
+        }
+    }
+    Ok((exr, png))
+}
+
+/// The scene with the command line's overrides applied.
+fn settings(args: &RenderArgs, scene: &mut Scene) {
+    let r = &mut scene.stage.render;
+    if let Some(spp) = args.spp {
+        r.spp = spp;
+    }
+    if let Some((w, h)) = args.size {
+        r.width = w;
+        r.height = h;
+    }
+    if let Some(seed) = args.seed {
+        r.seed = seed;
+    }
+    if let Some(s) = args.sampler {
+        r.sampler = match s {
+            SamplerArg::Sobol => SamplerKind::Sobol,
+            SamplerArg::Independent => SamplerKind::Independent,
+        };
+    }
+    if let Some(d) = args.max_depth {
+        r.max_depth = d;
+    }
+    if let Some(e) = args.exposure {
+        r.exposure = e;
+    }
+}
+
+/// Runs `lapidary render`; returns whether the render was interrupted by Ctrl-C.
+pub fn run(args: &RenderArgs) -> Result<bool> {
+    let (exr_path, png_path) = outputs(args)?;
+    let recipe = GemRecipe::load(&args.recipe).map_err(|e| anyhow!("{e}"))?;
+    let mut scene = recipe.compile().map_err(|e| anyhow!("{e}"))?;
+    settings(args, &mut scene);
+    let world = World::new(&scene).map_err(|e| anyhow!("{}: {e}", args.recipe.display()))?;
+    let r = scene.stage.render;
+
+    let total = u64::from(r.width) * u64::from(r.height) * u64::from(r.spp);
+    let bar = if args.quiet {
+        ProgressBar::hidden()
+    } else {
+        ProgressBar::new(total)
+    };
+    bar.set_style(
+        ProgressStyle::with_template(
+            "{spinner} [{elapsed_precise}] {wide_bar} {human_pos}/{human_len} samples \
+             {per_sec} ETA {eta}",
+        )
+        .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let progress = |n: u64| bar.inc(n);
+    let cancel = interrupted();
+    cancel.store(false, Ordering::SeqCst);
+    let control = Control {
+        threads: args.threads.map(|t| t as usize),
+        strategy: match args.strategy {
+            StrategyArg::Mis => Strategy::Mis,
+            StrategyArg::Light => Strategy::LightOnly,
+            StrategyArg::Bsdf => Strategy::BsdfOnly,
+        },
+        deadline: args
+            .time_limit
+            .map(|s| Instant::now() + Duration::from_secs_f64(s)),
+        cancel: Some(cancel),
+        progress: Some(&progress),
+    };
+    let dof = scene.effects.on(Effect::DepthOfField);
+    let rendered = render(&world, &scene.stage.camera, dof, &r, &control);
+    bar.finish_and_clear();
+    let was_interrupted = cancel.load(Ordering::SeqCst);
+
+    let meta = Metadata {
+        recipe: args.recipe.display().to_string(),
+        recipe_hash: scene.hash,
+        seed: r.seed,
+        spp: r.spp,
+        sampler: r.sampler.name().to_string(),
+        max_depth: r.max_depth,
+        materials: scene.surface.names.clone(),
+    };
+    write_exr(&exr_path, &exr_image(&rendered, &meta))
+        .with_context(|| format!("writing {}", exr_path.display()))?;
+    if let Some(png) = &png_path {
+        let tm = ToneMap {
+            exposure: r.exposure,
+            curve: match args.tonemap {
+                CurveArg::Filmic => Curve::Filmic,
+                CurveArg::Clamp => Curve::Clamp,
+            },
+        };
+        write_png(png, r.width, r.height, &rendered.film.rgb(), &tm)
+            .with_context(|| format!("writing {}", png.display()))?;
+    }
+    if !args.quiet {
+        print!(
+            "{}",
+            summary(
+                args,
+                &scene,
+                &rendered,
+                &exr_path,
+                png_path.as_deref(),
+                was_interrupted
+            )
+        );
+    }
+    Ok(was_interrupted)
+}
+
+/// Thousands separated by thin spaces.
+fn grouped(n: u64) -> String {
+    let s = n.to_string();
+    let mut out = String::new();
+    for (i, c) in s.chars().enumerate() {
+        if i > 0 && (s.len() - i) % 3 == 0 {
+            out.push(' ');
+        }
+        out.push(c);
+    }
+    out
+}
+
+/// The closing summary.
+fn summary(
+    args: &RenderArgs,
+    scene: &Scene,
+    r: &Rendered,
+    exr: &Path,
+    png: Option<&Path>,
+    interrupted: bool,
+) -> String {
+    let s = &r.stats;
+    let set = &scene.stage.render;
+    let secs = s.elapsed.as_secs_f64().max(1e-9);
+    let mut out = format!(
+        "rendered {}: {}x{}, {} spp ({}), depth {} in {:.1} s\n",
+        args.recipe.display(),
+        set.width,
+        set.height,
+        set.spp,
+        set.sampler.name(),
+        set.max_depth,
+        secs
+    );
+    if s.partial {
+        let why = if interrupted { "Ctrl-C" } else { "time limit" };
+        out += &format!(
+            "  stopped by {why}: partial, {} of {} spp in every pixel (the EXR says so)\n",
+            s.spp_complete, set.spp
+        );
+    }
+    out += &format!(
+        "  {} paths ({:.0} paths/s), {} rays ({:.2} M rays/s), {} dropped samples\n",
+        grouped(s.paths),
+        s.paths as f64 / secs,
+        grouped(s.rays),
+        s.rays as f64 / secs / 1e6,
+        grouped(s.dropped)
+    );
+    let effects: Vec<&str> = scene.effects.iter().map(Effect::name).collect();
+    out += &format!(
+        "  effects: {}\n",
+        if effects.is_empty() {
+            "none".to_string()
+        } else {
+            effects.join(", ")
+        }
+    );
+    out += &format!("  wrote {}", exr.display());
+    if let Some(p) = png {
+        out += &format!(", {}", p.display());
+    }
+    out.push('\n');
+    out
+}

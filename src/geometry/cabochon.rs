@@ -1,0 +1,285 @@
+//! The cabochon: a half-ellipsoid dome over a flat elliptical base or a shallower lower dome.
+//!
+//! Both variants are convex, so a ray meets the solid in one interval `[t_in, t_out]`, found as
+//! intersections and unions of intervals rather than by testing each surface patch separately
+//! and accepting points inside its boundary. There is no acceptance test at the rim to fail by
+//! rounding, so rays aimed at the rim cannot slip between the dome and the base.
+
+use super::ray::Ray;
+use super::solid::{GeometryError, ShapeHit, first_of_interval, valid_query};
+use super::sphere::sphere_interval;
+use glam::Vec3;
+
+/// A cabochon in object space: the dome `x²/rx² + y²/h² + z²/rz² ≤ 1, y ≥ 0` over the flat base
+/// `y = 0` (`base = 0`) or over the lower dome `x²/rx² + y²/base² + z²/rz² ≤ 1, y ≤ 0`. Lengths in
+/// object units.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Cabochon {
+    /// Semi-axes of the upper dome (rx, h, rz).
+    upper: Vec3,
+    /// Semi-axes of the lower dome (rx, base, rz); `base` is 0 for a flat base.
+    lower: Vec3,
+}
+
+/// `t` range of the half-space `y ≥ 0` (`up`) or `y ≤ 0` along `o + t·d`, as `(lo, hi)` with
+/// `NaN`-free infinities; `None` if the line runs parallel outside it.
+#[inline]
+fn half_space(oy: f32, dy: f32, up: bool) -> Option<(f32, f32)> {
+    let s = if up { 1.0 } else { -1.0 };
+    if dy == 0.0 {
+        return (s * oy >= 0.0).then_some((f32::NEG_INFINITY, f32::INFINITY));
+    }
+    let tp = -oy / dy;
+    if s * dy > 0.0 {
+        Some((tp, f32::INFINITY))
+    } else {
+        Some((f32::NEG_INFINITY, tp))
+    }
+}
+
+/// The interval of `o + t·d` inside the ellipsoid of semi-axes `axes` (in the space scaled to a
+/// unit sphere, where `t` is unchanged), intersected with the upper or lower half-space. The
+/// flags tell whether each end is on the plane `y = 0` rather than on the ellipsoid.
+#[inline]
+fn half_ellipsoid(o: Vec3, d: Vec3, axes: Vec3, up: bool) -> Option<(f32, f32, bool, bool)> {
+    let (e0, e1) = sphere_interval(o / axes, d / axes, 1.0)?;
+    let (h0, h1) = half_space(o.y, d.y, up)?;
+    let (t_in, in_plane) = if h0 > e0 { (h0, true) } else { (e0, false) };
+    let (t_out, out_plane) = if h1 < e1 { (h1, true) } else { (e1, false) };
+    (t_in <= t_out).then_some((t_in, t_out, in_plane, out_plane))
+}
+
+/// `p` projected radially (in the space where the ellipsoid of semi-axes `axes` is a unit sphere)
+/// onto that ellipsoid, and the unit outward normal there (the gradient `(x/a², y/b², z/c²)`).
+#[inline]
+fn on_ellipsoid(p: Vec3, axes: Vec3) -> (Vec3, Vec3) {
+    let u = (p / axes).normalize_or(Vec3::Y);
+    (u * axes, (u / axes).normalize_or(Vec3::Y))
+}
+
+impl Cabochon {
+    /// A cabochon of semi-axes `rx`, `rz` (horizontal), dome height `h` and lower dome depth
+    /// `base` (0 for a flat base). All must be finite, `rx`, `h`, `rz` positive, `base ≥ 0`.
+    pub fn new(rx: f32, h: f32, rz: f32, base: f32) -> Result<Cabochon, GeometryError> {
+        let ok = |v: f32| v > 0.0 && v.is_finite() && v < 1e18;
+        if !(ok(rx) && ok(h) && ok(rz) && (base == 0.0 || ok(base))) {
+            return Err(GeometryError::Degenerate {
+                shape: "cabochon",
+                detail: format!(
+                    "radii and height must be finite and positive, base finite and ≥ 0; got \
+                     radius ({rx}, {rz}), height {h}, base {base}"
+                ),
+            });
+        }
+        Ok(Cabochon {
+            upper: Vec3::new(rx, h, rz),
+            lower: Vec3::new(rx, base, rz),
+        })
+    }
+
+    /// Whether the base is flat.
+    pub fn flat_base(&self) -> bool {
+        self.lower.y == 0.0
+    }
+
+    /// Closest hit with `0 < t < t_max` (object space, `t` in units of `ray.dir`).
+    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<ShapeHit> {
+        if !valid_query(ray, t_max) {
+            return None;
+        }
+        let (o, d) = (ray.origin, ray.dir);
+        if self.flat_base() {
+            // Convex: ellipsoid ∩ {y ≥ 0}; the plane ends are the base disc.
+            let (t_in, t_out, in_plane, out_plane) = half_ellipsoid(o, d, self.upper, true)?;
+            let (t, exit) = first_of_interval(t_in, t_out, t_max)?;
+            if if exit { out_plane } else { in_plane } {
+                let p = ray.at(t);
+                let p = Vec3::new(p.x, 0.0, p.z);
+                return Some(ShapeHit {
+                    t,
+                    ng: Vec3::NEG_Y,
+                    ns: Vec3::NEG_Y,
+                    p,
+                });
+            }
+            let (mut p, n) = on_ellipsoid(ray.at(t), self.upper);
+            p.y = p.y.max(0.0);
+            return Some(ShapeHit { t, ng: n, ns: n, p });
+        }
+        // Domed base: the union of the two half-ellipsoids, convex because they share the
+        // equator and the surface normal is continuous across it. The union of the two pieces'
+        // intervals is the solid's interval; an end on the plane y = 0 can only survive the
+        // union at the rim (a rounding tie), where both ellipsoids and their normals agree.
+        let up = half_ellipsoid(o, d, self.upper, true);
+        let down = half_ellipsoid(o, d, self.lower, false);
+        let (t_in, t_out) = match (up, down) {
+            (Some(a), Some(b)) => (a.0.min(b.0), a.1.max(b.1)),
+            (Some(a), None) | (None, Some(a)) => (a.0, a.1),
+            (None, None) => return None,
+        };
+        let (t, _) = first_of_interval(t_in, t_out, t_max)?;
+        let q = ray.at(t);
+        let (p, n) = on_ellipsoid(q, if q.y >= 0.0 { self.upper } else { self.lower });
+        Some(ShapeHit { t, ng: n, ns: n, p })
+    }
+
+    /// Object-space bounds `(min, max)`.
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        let (a, b) = (self.upper, self.lower);
+        (Vec3::new(-a.x, -b.y, -a.z), a)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::solid::Solid;
+    use crate::geometry::solid::test_util::*;
+    use crate::sampler::Rng;
+
+    const RX: f32 = 1.2;
+    const H: f32 = 0.7;
+    const RZ: f32 = 0.9;
+
+    fn solid(base: f32) -> Solid {
+        Solid::Cabochon(Cabochon::new(RX, H, RZ, base).unwrap())
+    }
+
+    /// Distance-like residual of `p` from the cabochon's surface (0 on it).
+    fn residual(p: Vec3, base: f32) -> f32 {
+        let e = |c: f32| (p.x / RX).powi(2) + (p.y / c).powi(2) + (p.z / RZ).powi(2) - 1.0;
+        if p.y >= 0.0 {
+            let dome = e(H).abs();
+            if base == 0.0 {
+                let disc = p.y.abs() + (e(1.0) - p.y * p.y).max(0.0);
+                dome.min(disc)
+            } else {
+                dome
+            }
+        } else if base == 0.0 {
+            p.y.abs() + (e(1.0) - p.y * p.y).max(0.0)
+        } else {
+            e(base).abs()
+        }
+    }
+
+    #[test]
+    fn known_hits_flat_and_domed() {
+        for base in [0.0, 0.4] {
+            let c = solid(base);
+            let h = c
+                .intersect(&Ray::new(Vec3::new(0.0, 5.0, 0.0), Vec3::NEG_Y), 1e9)
+                .unwrap();
+            assert!((h.t - (5.0 - H)).abs() < 1e-6 && h.ng == Vec3::Y, "{h:?}");
+            let h = c
+                .intersect(&Ray::new(Vec3::new(0.0, -5.0, 0.0), Vec3::Y), 1e9)
+                .unwrap();
+            assert!(
+                (h.t - (5.0 - base)).abs() < 1e-6 && h.ng == Vec3::NEG_Y,
+                "{h:?}"
+            );
+            let h = c
+                .intersect(&Ray::new(Vec3::new(-5.0, 0.3, 0.0), Vec3::X), 1e9)
+                .unwrap();
+            let x = RX * (1.0 - (0.3f32 / H).powi(2)).sqrt();
+            assert!((h.t - (5.0 - x)).abs() < 1e-5 && h.ng.x < 0.0 && h.ng.y > 0.0);
+            // Oblique ray aimed at a known dome point.
+            let u = Vec3::new(0.3, 0.8, -0.4).normalize();
+            let target = u * Vec3::new(RX, H, RZ);
+            let n = (u / Vec3::new(RX, H, RZ)).normalize();
+            let dir = Vec3::new(-0.3, -1.0, 0.2).normalize();
+            let h = c
+                .intersect(&Ray::new(target - 3.0 * dir, dir), 1e9)
+                .unwrap();
+            assert!(
+                (h.t - 3.0).abs() < 1e-5 && (h.ng - n).length() < 1e-5,
+                "{h:?}"
+            );
+            // Inside: exits through the dome top.
+            let h = c
+                .intersect(&Ray::new(Vec3::new(0.0, 0.1, 0.0), Vec3::Y), 1e9)
+                .unwrap();
+            assert!((h.t - (H - 0.1)).abs() < 1e-6 && h.ng == Vec3::Y);
+            // Misses and t_max.
+            assert!(
+                c.intersect(&Ray::new(Vec3::new(0.0, 0.1, -5.0), Vec3::X), 1e9)
+                    .is_none()
+            );
+            assert!(
+                c.intersect(&Ray::new(Vec3::new(2.0, 5.0, 0.0), Vec3::NEG_Y), 1e9)
+                    .is_none()
+            );
+            let ray = Ray::new(Vec3::new(0.0, 5.0, 0.0), Vec3::NEG_Y);
+            assert!(c.intersect(&ray, 5.0 - H - 1e-3).is_none());
+            assert!(!c.occluded(&ray, 5.0 - H - 1e-3) && c.occluded(&ray, 5.0 - H + 1e-3));
+            check_bad_rays(&c);
+        }
+        // A flat base seen from below below the rim, slightly oblique.
+        let c = solid(0.0);
+        let dir = Vec3::new(0.1, 1.0, 0.05).normalize();
+        let h = c
+            .intersect(&Ray::new(Vec3::new(0.2, -2.0, 0.1), dir), 1e9)
+            .unwrap();
+        assert!((h.t - 2.0 / dir.y).abs() < 1e-5 && h.ng == Vec3::NEG_Y && h.p.y == 0.0);
+        for (rx, h, rz, b) in [
+            (0.0, 1.0, 1.0, 0.0),
+            (1.0, -1.0, 1.0, 0.0),
+            (1.0, 1.0, 1.0, -0.1),
+        ] {
+            assert!(Cabochon::new(rx, h, rz, b).is_err());
+        }
+        assert!(Cabochon::new(1.0, 1.0, f32::NAN, 0.0).is_err());
+    }
+
+    #[test]
+    fn rim_rays_do_not_slip_through() {
+        // A dense fan of rays from outside aimed exactly at rim points, from above, below and the
+        // side; all must hit near the aimed point (the ray does enter the solid there).
+        for base in [0.0, 0.4] {
+            let c = solid(base);
+            let mut rng = Rng::new(7);
+            for i in 0..20_000 {
+                let phi = i as f32 * (std::f32::consts::TAU / 20_000.0);
+                let rim = Vec3::new(RX * phi.cos(), 0.0, RZ * phi.sin());
+                let outward = Vec3::new(phi.cos() / RX, 0.0, phi.sin() / RZ).normalize();
+                // Directions that enter the solid at the rim: an inward horizontal component
+                // plus a vertical one, upward only for the flat base (downward ones would just
+                // graze its edge). Every 10th ray is horizontal, in the plane of the rim.
+                let vy = match (i % 10, base == 0.0) {
+                    (0, _) => 0.0,
+                    (_, true) => 0.02 + rng.uniform(),
+                    (_, false) => 2.0 * rng.uniform() - 1.0,
+                };
+                let dir = (-outward * (0.2 + rng.uniform()) + Vec3::Y * vy).normalize();
+                let origin = rim - dir * (1.0 + 3.0 * rng.uniform());
+                let ray = Ray::new(origin, dir);
+                let h = c.intersect(&ray, f32::INFINITY);
+                let h = h.unwrap_or_else(|| panic!("slipped through: {ray:?}, base {base}"));
+                assert!((ray.at(h.t) - rim).length() < 1e-4, "{h:?}");
+                assert!(c.occluded(&ray, f32::INFINITY));
+            }
+        }
+    }
+
+    #[test]
+    fn random_rays_on_surface_and_consistent() {
+        for base in [0.0, 0.4] {
+            let c = solid(base);
+            let hits = check_occluded_agrees(&c, 2.0, 3);
+            assert!(hits > 2000, "{hits}");
+            let mut rng = Rng::new(4);
+            for _ in 0..10_000 {
+                let ray = random_ray(&mut rng, 2.0);
+                let Some(h) = c.intersect(&ray, f32::INFINITY) else {
+                    continue;
+                };
+                let p = ray.at(h.t);
+                assert!(residual(p, base) < 1e-5, "{p} {h:?}");
+                assert!(residual(h.p, base) < 1e-5, "{h:?}");
+                // Convex with the origin inside: the outward normal faces away from it.
+                assert!(h.ng.dot(p - Vec3::new(0.0, 0.1, 0.0)) > 0.0, "{p} {h:?}");
+                assert!((h.ng.length() - 1.0).abs() < 1e-5);
+            }
+        }
+    }
+}

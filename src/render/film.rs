@@ -1,0 +1,210 @@
+//! The film: per-pixel sums of samples, from which the mean, the variance of the mean and the
+//! AOVs are read. Sums are `f64` and each pixel's samples are added in sample order by one thread,
+//! so the result does not depend on scheduling.
+
+use super::integrator::PathSample;
+use crate::color::Spectrum;
+
+/// The accumulated samples of one pixel.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PixelSums {
+    /// Σ radiance per channel.
+    pub sum: [f64; 3],
+    /// Σ radiance² per channel.
+    pub sum_sq: [f64; 3],
+    /// Samples kept.
+    pub n: u32,
+    /// Samples dropped because their radiance was not finite (or negative).
+    pub dropped: u32,
+    /// Σ first-hit albedo.
+    pub albedo: [f64; 3],
+    /// Σ first-hit normal.
+    pub normal: [f64; 3],
+    /// Σ first-hit distance over samples that hit something, and their count.
+    pub depth: f64,
+    /// Samples that hit something.
+    pub depth_n: u32,
+    /// Material index of the pixel's first sample (−1 floor, −2 nothing), `i32::MIN` before any.
+    pub material: i32,
+    /// Rays traced for the pixel.
+    pub rays: u64,
+}
+
+impl PixelSums {
+    /// An empty pixel.
+    pub const EMPTY: PixelSums = PixelSums {
+        sum: [0.0; 3],
+        sum_sq: [0.0; 3],
+        n: 0,
+        dropped: 0,
+        albedo: [0.0; 3],
+        normal: [0.0; 3],
+        depth: 0.0,
+        depth_n: 0,
+        material: i32::MIN,
+        rays: 0,
+    };
+
+    /// Adds one sample; a sample whose radiance is not finite and non-negative is dropped and
+    /// counted (its AOVs are kept: they are finite by construction).
+    pub fn add(&mut self, s: &PathSample) {
+        self.rays += u64::from(s.rays);
+        if self.material == i32::MIN {
+            self.material = s.material;
+        }
+        for c in 0..3 {
+            self.albedo[c] += f64::from(s.albedo[c]);
+        }
+        for (acc, v) in self.normal.iter_mut().zip(s.normal.to_array()) {
+            *acc += f64::from(v);
+        }
+        if let Some(t) = s.depth.filter(|t| t.is_finite()) {
+            self.depth += f64::from(t);
+            self.depth_n += 1;
+        }
+        if !s.radiance.is_valid() {
+            self.dropped += 1;
+            return;
+        }
+        self.n += 1;
+        for c in 0..3 {
+            let v = f64::from(s.radiance[c]);
+            self.sum[c] += v;
+            self.sum_sq[c] += v * v;
+        }
+    }
+
+    /// Mean radiance (0 without samples).
+    pub fn mean(&self) -> Spectrum {
+        let n = f64::from(self.n.max(1));
+        Spectrum(self.sum.map(|s| (s / n) as f32))
+    }
+
+    /// Variance of the mean per channel: the unbiased sample variance over `n` (0 below 2
+    /// samples).
+    pub fn variance_of_mean(&self) -> [f32; 3] {
+        if self.n < 2 {
+            return [0.0; 3];
+        }
+        let n = f64::from(self.n);
+        std::array::from_fn(|c| {
+            let var = (self.sum_sq[c] - self.sum[c] * self.sum[c] / n) / (n - 1.0);
+            (var.max(0.0) / n) as f32
+        })
+    }
+
+    /// Samples taken (kept and dropped), the denominator of the AOV means.
+    fn taken(&self) -> f64 {
+        f64::from((self.n + self.dropped).max(1))
+    }
+
+    /// Mean first-hit albedo.
+    pub fn mean_albedo(&self) -> [f32; 3] {
+        self.albedo.map(|a| (a / self.taken()) as f32)
+    }
+
+    /// Mean first-hit normal, renormalised (0 where nothing was hit).
+    pub fn mean_normal(&self) -> [f32; 3] {
+        let v = self.normal;
+        let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        if len > 0.0 {
+            v.map(|c| (c / len) as f32)
+        } else {
+            [0.0; 3]
+        }
+    }
+
+    /// Mean first-hit distance over the samples that hit something (0 if none did).
+    pub fn mean_depth(&self) -> f32 {
+        if self.depth_n == 0 {
+            0.0
+        } else {
+            (self.depth / f64::from(self.depth_n)) as f32
+        }
+    }
+}
+
+/// A `width × height` grid of pixel sums, row-major, top row first.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Film {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// The pixels.
+    pub pixels: Vec<PixelSums>,
+}
+
+impl Film {
+    /// An empty film.
+    pub fn new(width: u32, height: u32) -> Self {
+        Film {
+            width,
+            height,
+            pixels: vec![PixelSums::EMPTY; width as usize * height as usize],
+        }
+    }
+
+    /// Mean radiance per pixel.
+    pub fn rgb(&self) -> Vec<[f32; 3]> {
+        self.pixels.iter().map(|p| p.mean().0).collect()
+    }
+
+    /// Samples dropped over the whole film.
+    pub fn dropped(&self) -> u64 {
+        self.pixels.iter().map(|p| u64::from(p.dropped)).sum()
+    }
+
+    /// Samples kept over the whole film.
+    pub fn samples(&self) -> u64 {
+        self.pixels.iter().map(|p| u64::from(p.n)).sum()
+    }
+
+    /// Rays traced over the whole film.
+    pub fn rays(&self) -> u64 {
+        self.pixels.iter().map(|p| p.rays).sum()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample(v: f32) -> PathSample {
+        PathSample {
+            radiance: Spectrum::splat(v),
+            albedo: Spectrum::splat(0.5),
+            normal: glam::Vec3::Y,
+            depth: Some(2.0),
+            material: 3,
+            rays: 2,
+        }
+    }
+
+    #[test]
+    fn mean_and_variance_of_the_mean() {
+        let mut p = PixelSums::EMPTY;
+        for v in [1.0, 2.0, 3.0, 4.0] {
+            p.add(&sample(v));
+        }
+        assert_eq!(p.mean()[0], 2.5);
+        // Sample variance 5/3, over n = 4.
+        assert!((p.variance_of_mean()[1] - 5.0 / 12.0).abs() < 1e-6);
+        assert_eq!(p.material, 3);
+        assert_eq!(p.mean_depth(), 2.0);
+        assert_eq!(p.mean_normal(), [0.0, 1.0, 0.0]);
+        assert_eq!(p.rays, 8);
+    }
+
+    #[test]
+    fn non_finite_and_negative_samples_are_dropped_and_counted() {
+        let mut p = PixelSums::EMPTY;
+        for v in [1.0, f32::NAN, f32::INFINITY, -1.0, 3.0] {
+            p.add(&sample(v));
+        }
+        assert_eq!((p.n, p.dropped), (2, 3));
+        assert_eq!(p.mean()[2], 2.0);
+        assert!(p.variance_of_mean().iter().all(|v| v.is_finite()));
+        assert_eq!(p.mean_albedo(), [0.5; 3]);
+    }
+}

@@ -1,0 +1,104 @@
+//! The EXR a render writes: colour, AOVs and metadata (DESIGN §6).
+//!
+//! Channels (all 32-bit float, one part):
+//!
+//! | channels | content |
+//! |---|---|
+//! | `R`, `G`, `B` | mean linear Rec.709 radiance |
+//! | `albedo.R/G/B` | mean first-hit albedo (normal-incidence albedo of the stone's material, the floor's albedo; 0 for the sky and lights) |
+//! | `normal.X/Y/Z` | mean first-hit world shading normal (facet normal on glitter), unit; 0 where nothing was hit |
+//! | `depth.Z` | mean distance to the first hit along the camera ray, over samples that hit; 0 where none did |
+//! | `variance.R/G/B` | variance of the pixel mean (sample variance / n), for z-tests against references |
+//! | `samples.Y` | samples kept in the pixel (fewer than `spp` in a partial render or where samples were dropped) |
+//! | `material.Y` | material index of the pixel's first sample (see `lapidary.materials`); −1 floor, −2 nothing |
+//!
+//! Attributes (text): `lapidary.version`, `lapidary.recipe`, `lapidary.recipe_hash` (16 hex
+//! digits), `lapidary.seed`, `lapidary.spp` (requested), `lapidary.spp_complete`,
+//! `lapidary.sampler`, `lapidary.max_depth`, `lapidary.render_time` (seconds),
+//! `lapidary.dropped`, `lapidary.partial` (`true`/`false`), `lapidary.materials`
+//! (`index=name` pairs separated by `;`).
+
+use super::Rendered;
+use crate::image::{Channel, ExrImage};
+
+/// What the EXR's header records about a render.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Metadata {
+    /// Recipe file as given on the command line.
+    pub recipe: String,
+    /// Hash of the recipe and its includes.
+    pub recipe_hash: u64,
+    /// Seed of the pixel samples.
+    pub seed: u64,
+    /// Requested samples per pixel.
+    pub spp: u32,
+    /// Sampler name.
+    pub sampler: String,
+    /// Longest path in bounces.
+    pub max_depth: u32,
+    /// Material names by index.
+    pub materials: Vec<String>,
+}
+
+/// The EXR image of a render.
+pub fn exr_image(r: &Rendered, meta: &Metadata) -> ExrImage {
+    let px = &r.film.pixels;
+    let channel = |name: &str, f: &dyn Fn(&super::PixelSums) -> f32| Channel {
+        name: name.to_string(),
+        data: px.iter().map(f).collect(),
+    };
+    let mut channels = Vec::with_capacity(16);
+    for (c, name) in ["R", "G", "B"].iter().enumerate() {
+        channels.push(channel(name, &|p| p.mean()[c]));
+        channels.push(channel(&format!("albedo.{name}"), &|p| p.mean_albedo()[c]));
+        channels.push(channel(&format!("variance.{name}"), &|p| {
+            p.variance_of_mean()[c]
+        }));
+    }
+    for (c, name) in ["X", "Y", "Z"].iter().enumerate() {
+        channels.push(channel(&format!("normal.{name}"), &|p| p.mean_normal()[c]));
+    }
+    channels.push(channel("depth.Z", &|p| p.mean_depth()));
+    channels.push(channel("samples.Y", &|p| p.n as f32));
+    channels.push(channel("material.Y", &|p| {
+        if p.material == i32::MIN {
+            -2.0
+        } else {
+            p.material as f32
+        }
+    }));
+    let s = &r.stats;
+    let materials = meta
+        .materials
+        .iter()
+        .enumerate()
+        .map(|(i, n)| format!("{i}={n}"))
+        .collect::<Vec<_>>()
+        .join(";");
+    let attributes = [
+        ("lapidary.version", env!("CARGO_PKG_VERSION").to_string()),
+        ("lapidary.recipe", meta.recipe.clone()),
+        ("lapidary.recipe_hash", format!("{:016x}", meta.recipe_hash)),
+        ("lapidary.seed", meta.seed.to_string()),
+        ("lapidary.spp", meta.spp.to_string()),
+        ("lapidary.spp_complete", s.spp_complete.to_string()),
+        ("lapidary.sampler", meta.sampler.clone()),
+        ("lapidary.max_depth", meta.max_depth.to_string()),
+        (
+            "lapidary.render_time",
+            format!("{:.3}", s.elapsed.as_secs_f64()),
+        ),
+        ("lapidary.dropped", s.dropped.to_string()),
+        ("lapidary.partial", s.partial.to_string()),
+        ("lapidary.materials", materials),
+    ]
+    .into_iter()
+    .map(|(k, v)| (k.to_string(), v))
+    .collect();
+    ExrImage {
+        width: r.film.width,
+        height: r.film.height,
+        channels,
+        attributes,
+    }
+}

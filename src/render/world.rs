@@ -1,0 +1,249 @@
+//! The runtime world the integrator traces: the placed stone, the floor, the lights and the
+//! material table, built once from a compiled [`Scene`].
+
+use crate::bsdf::{Bsdf, Bxdf, Lambert, LayeredBsdf, StackError};
+use crate::color::Spectrum;
+use crate::geometry::{GeometryError, Ray, Stone, StoneHit};
+use crate::image::ImageError;
+use crate::light::{Area, EnvironmentLight};
+use crate::scene::{Effect, Scene};
+use crate::texture::Map;
+use glam::{Vec2, Vec3};
+use thiserror::Error;
+
+/// Why a scene cannot be turned into a world.
+#[derive(Debug, Error)]
+pub enum WorldError {
+    /// The stone's shape could not be built (a mesh that does not load, …).
+    #[error("stone shape: {0}")]
+    Shape(#[from] GeometryError),
+    /// A material's stack is invalid.
+    #[error("material `{name}`: {source}")]
+    Material {
+        /// Its name.
+        name: String,
+        /// What is wrong.
+        source: StackError,
+    },
+    /// The environment map could not be read.
+    #[error("environment map: {0}")]
+    Environment(#[from] ImageError),
+}
+
+/// What a ray hit first.
+#[derive(Clone, Copy, Debug)]
+pub enum Hit {
+    /// The stone.
+    Stone(StoneHit),
+    /// The floor at distance `t`, point `p`.
+    Ground {
+        /// Distance along the ray.
+        t: f32,
+        /// World point.
+        p: Vec3,
+    },
+    /// Area light `index` at distance `t`.
+    Light {
+        /// Index into [`World::areas`].
+        index: usize,
+        /// Distance along the ray.
+        t: f32,
+    },
+}
+
+impl Hit {
+    /// Distance along the ray.
+    pub fn t(&self) -> f32 {
+        match *self {
+            Hit::Stone(h) => h.t,
+            Hit::Ground { t, .. } | Hit::Light { t, .. } => t,
+        }
+    }
+}
+
+/// A light chosen for next-event estimation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LightRef {
+    /// Area light `i`.
+    Area(usize),
+    /// The environment.
+    Environment,
+}
+
+/// The traced world.
+#[derive(Debug)]
+pub struct World {
+    /// The placed stone.
+    pub stone: Stone,
+    /// The floor height and its Lambertian BSDF, if there is a floor.
+    pub ground: Option<(f32, Bsdf)>,
+    /// Area lights.
+    pub areas: Vec<Area>,
+    /// The environment.
+    pub environment: EnvironmentLight,
+    /// Selection probabilities for next-event estimation: areas in order, then the environment.
+    pub light_prob: Vec<f32>,
+    /// Runtime BSDFs by material index (`None`: the map tree never uses it).
+    pub materials: Vec<Option<Bsdf>>,
+    /// Directional albedo at normal incidence by material index (for the albedo AOV).
+    pub albedo: Vec<Spectrum>,
+    /// The map tree.
+    pub map: Map,
+    /// Whether the map tree has a stochastic switch (else its `u` is never drawn).
+    pub stochastic_switch: bool,
+    /// Whether facet bumps apply.
+    pub facet_bump: bool,
+    /// Centre and radius of a sphere bounding the stone, the floor patch under it and the lights.
+    pub bounds: (Vec3, f32),
+}
+
+impl World {
+    /// Builds the world for `scene` (loads the mesh and environment map, builds BSDF tables).
+    pub fn new(scene: &Scene) -> Result<World, WorldError> {
+        let stage = &scene.stage;
+        let stone = Stone::new(&stage.shape, stage.to_world)?;
+        let mut materials = Vec::with_capacity(scene.surface.stacks.len());
+        let mut albedo = Vec::with_capacity(scene.surface.stacks.len());
+        for (k, desc) in scene.surface.stacks.iter().enumerate() {
+            if !scene.surface.used[k] {
+                materials.push(None);
+                albedo.push(Spectrum::ZERO);
+                continue;
+            }
+            let stack = LayeredBsdf::new(desc).map_err(|source| WorldError::Material {
+                name: scene.surface.names[k].clone(),
+                source,
+            })?;
+            let bsdf = Bsdf::from(stack);
+            albedo.push(normal_albedo(&bsdf));
+            materials.push(Some(bsdf));
+        }
+        let ground = stage
+            .ground
+            .map(|g| (g.height, Bsdf::Lambert(Lambert { albedo: g.albedo })));
+        let areas: Vec<Area> = stage.lights.iter().map(Area::new).collect();
+        let environment = EnvironmentLight::new(&stage.environment)?;
+
+        let (lo, hi) = stone.bounds();
+        let mut lo = lo;
+        let mut hi = hi;
+        for l in &stage.lights {
+            lo = lo.min(l.center);
+            hi = hi.max(l.center);
+        }
+        let centre = 0.5 * (lo + hi);
+        let radius = (0.5 * (hi - lo).length()).max(1e-3);
+
+        let mut power: Vec<f32> = areas.iter().map(Area::power).collect();
+        power.push(if environment.is_black() {
+            0.0
+        } else {
+            environment.power(radius)
+        });
+        let total: f32 = power.iter().filter(|p| p.is_finite()).sum();
+        let light_prob = power
+            .iter()
+            .map(|&p| {
+                if total > 0.0 && p.is_finite() {
+                    p / total
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+
+        Ok(World {
+            stone,
+            ground,
+            areas,
+            environment,
+            light_prob,
+            materials,
+            albedo,
+            map: scene.surface.map.clone(),
+            stochastic_switch: scene.effects.on(Effect::StochasticSwitch),
+            facet_bump: scene.effects.on(Effect::FacetBump),
+            bounds: (centre, radius),
+        })
+    }
+
+    /// The closest hit along `ray` (unit direction) before `t_max`.
+    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
+        let mut best = self.stone.intersect(ray, t_max).map(Hit::Stone);
+        let mut t_best = best.map_or(t_max, |h| h.t());
+        if let Some((h, _)) = self.ground {
+            let t = (h - ray.origin.y) / ray.dir.y;
+            if t > 0.0 && t < t_best {
+                t_best = t;
+                best = Some(Hit::Ground { t, p: ray.at(t) });
+            }
+        }
+        for (index, a) in self.areas.iter().enumerate() {
+            if let Some(t) = a.intersect(ray, t_best) {
+                t_best = t;
+                best = Some(Hit::Light { index, t });
+            }
+        }
+        best
+    }
+
+    /// Whether anything blocks `ray` before `t_max`.
+    pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
+        if let Some((h, _)) = self.ground {
+            let t = (h - ray.origin.y) / ray.dir.y;
+            if t > 0.0 && t < t_max {
+                return true;
+            }
+        }
+        self.areas.iter().any(|a| a.intersect(ray, t_max).is_some())
+            || self.stone.occluded(ray, t_max)
+    }
+
+    /// Picks a light for next-event estimation with `u ∈ [0, 1)`; returns it and its probability.
+    pub fn pick_light(&self, u: f32) -> Option<(LightRef, f32)> {
+        let mut acc = 0.0;
+        let mut last = None;
+        for (i, &p) in self.light_prob.iter().enumerate() {
+            if p <= 0.0 {
+                continue;
+            }
+            acc += p;
+            last = Some((i, p));
+            if u < acc {
+                break;
+            }
+        }
+        let (i, p) = last?;
+        let light = if i < self.areas.len() {
+            LightRef::Area(i)
+        } else {
+            LightRef::Environment
+        };
+        Some((light, p))
+    }
+
+    /// Probability that [`World::pick_light`] picks `light`.
+    pub fn light_probability(&self, light: LightRef) -> f32 {
+        match light {
+            LightRef::Area(i) => self.light_prob[i],
+            LightRef::Environment => self.light_prob[self.areas.len()],
+        }
+    }
+}
+
+/// Directional albedo at normal incidence, from a fixed stratified set of 256 samples (for the
+/// albedo AOV only).
+fn normal_albedo(bsdf: &Bsdf) -> Spectrum {
+    let n = 16;
+    let mut sum = Spectrum::ZERO;
+    for i in 0..n {
+        for j in 0..n {
+            let u = Vec2::new((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32);
+            let uc = ((i * n + j) as f32 + 0.5) / (n * n) as f32;
+            if let Some(s) = bsdf.sample(Vec3::Z, uc, u) {
+                sum += s.weight;
+            }
+        }
+    }
+    (sum * (1.0 / (n * n) as f32)).map(|v| v.clamp(0.0, 1.0))
+}
