@@ -179,7 +179,7 @@ fn info_prints_materials_map_statistics_stage_and_effects() {
         "cells/unit",
         "surface.over ",
         "stage:",
-        "render       480×360, 64 spp",
+        "render       640×480, 64 spp",
         "on   facet-bump               surface.over.bump = Cone { half_angle: 25.0 }",
         "on   stochastic-switch",
         "off  depth-of-field",

@@ -32,7 +32,7 @@ pub struct RenderArgs {
     /// Samples per pixel (default: the recipe's, else 64).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_048_576))]
     pub spp: Option<u32>,
-    /// Image size `WxH` in pixels (default: the recipe's, else 480x360).
+    /// Image size `WxH` in pixels (default: the recipe's, else 640x480).
     #[arg(long, value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
     /// Seed of the pixel samples (default: the recipe's `render.seed`, else 0).

@@ -14,7 +14,7 @@
 //!     environment: Gradient(zenith: Gray(0.08), horizon: Gray(0.05), nadir: Gray(0.02)),
 //!     lights: [Rect(center: (-2.5, 4.0, 2.0), size: (3.0, 2.0), radiance: Gray(4.0))],
 //!     camera: Perspective(from: (0.0, 2.6, 4.2), to: (0.0, 0.15, 0.0), fov: 30.0),
-//!     render: (width: 480, height: 360, spp: 64),
+//!     render: (width: 640, height: 480, spp: 64),
 //! )
 //! ```
 

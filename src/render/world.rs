@@ -9,6 +9,7 @@ use crate::light::{Area, EnvironmentLight};
 use crate::scene::{Effect, Scene};
 use crate::texture::Map;
 use glam::{Vec2, Vec3};
+use rayon::prelude::*;
 use thiserror::Error;
 
 /// Why a scene cannot be turned into a world.
@@ -102,21 +103,39 @@ impl World {
     pub fn new(scene: &Scene) -> Result<World, WorldError> {
         let stage = &scene.stage;
         let stone = Stone::new(&stage.shape, stage.to_world)?;
-        let mut materials = Vec::with_capacity(scene.surface.stacks.len());
-        let mut albedo = Vec::with_capacity(scene.surface.stacks.len());
-        for (k, desc) in scene.surface.stacks.iter().enumerate() {
-            if !scene.surface.used[k] {
-                materials.push(None);
-                albedo.push(Spectrum::ZERO);
-                continue;
+        // Tables take tens of milliseconds per material: build them in parallel (the result is
+        // the same in any order).
+        let built: Vec<Result<Option<(Bsdf, Spectrum)>, WorldError>> = scene
+            .surface
+            .stacks
+            .par_iter()
+            .enumerate()
+            .map(|(k, desc)| {
+                if !scene.surface.used[k] {
+                    return Ok(None);
+                }
+                let stack = LayeredBsdf::new(desc).map_err(|source| WorldError::Material {
+                    name: scene.surface.names[k].clone(),
+                    source,
+                })?;
+                let bsdf = Bsdf::from(stack);
+                let albedo = normal_albedo(&bsdf);
+                Ok(Some((bsdf, albedo)))
+            })
+            .collect();
+        let mut materials = Vec::with_capacity(built.len());
+        let mut albedo = Vec::with_capacity(built.len());
+        for b in built {
+            match b? {
+                Some((bsdf, a)) => {
+                    materials.push(Some(bsdf));
+                    albedo.push(a);
+                }
+                None => {
+                    materials.push(None);
+                    albedo.push(Spectrum::ZERO);
+                }
             }
-            let stack = LayeredBsdf::new(desc).map_err(|source| WorldError::Material {
-                name: scene.surface.names[k].clone(),
-                source,
-            })?;
-            let bsdf = Bsdf::from(stack);
-            albedo.push(normal_albedo(&bsdf));
-            materials.push(Some(bsdf));
         }
         let ground = stage
             .ground

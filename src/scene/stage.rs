@@ -308,8 +308,8 @@ impl Stage {
             ],
             camera,
             render: RenderSettings {
-                width: 480,
-                height: 360,
+                width: 640,
+                height: 480,
                 spp: 64,
                 max_depth: 8,
                 sampler: SamplerKind::Sobol,
