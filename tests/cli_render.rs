@@ -490,11 +490,9 @@ fn bad_arguments_name_the_allowed_values() {
     assert_eq!(dir.files(), Vec::<String>::new(), "nothing written");
 }
 
-/// `--time-limit -1` (value as a separate word) should be reported like `--time-limit=-1` and
-/// `--exposure -31`, naming the range; clap instead says "unexpected argument '-1' found" because
-/// the option lacks `allow_hyphen_values` (which `--exposure` has).
+/// `--time-limit -1` (value as a separate word) is reported like `--time-limit=-1` and
+/// `--exposure -31`, naming the range (it once said "unexpected argument '-1' found").
 #[test]
-#[ignore = "bug: `render RECIPE --time-limit -1` says \"unexpected argument '-1' found\" without naming the range (0, 1e7]"]
 fn negative_time_limit_as_a_separate_word_names_the_range() {
     let dir = Scratch::new("negative-time");
     let out = render(&dir, &[SUNSTONE, "--time-limit", "-1"]);

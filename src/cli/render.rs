@@ -48,7 +48,7 @@ pub struct RenderArgs {
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub max_depth: Option<u32>,
     /// Stop after this many seconds and write what was rendered (marked partial).
-    #[arg(long, value_parser = parse_seconds)]
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_seconds)]
     pub time_limit: Option<f64>,
     /// PNG exposure in stops (default: the recipe's, else 0).
     #[arg(long, allow_hyphen_values = true, value_parser = parse_exposure)]
@@ -271,12 +271,12 @@ pub fn run(args: &RenderArgs) -> Result<bool> {
     Ok(was_interrupted)
 }
 
-/// Thousands separated by thin spaces.
+/// Thousands separated by spaces.
 fn grouped(n: u64) -> String {
     let s = n.to_string();
     let mut out = String::new();
     for (i, c) in s.chars().enumerate() {
-        if i > 0 && (s.len() - i) % 3 == 0 {
+        if i > 0 && (s.len() - i).is_multiple_of(3) {
             out.push(' ');
         }
         out.push(c);

@@ -190,7 +190,7 @@ pub fn trace(
             if !(sampler.get1d() < q) {
                 break;
             }
-            beta = beta * (1.0 / q);
+            beta *= 1.0 / q;
         }
         if !beta.is_valid() || beta.is_black() {
             break;

@@ -90,8 +90,6 @@ pub struct World {
     pub albedo: Vec<Spectrum>,
     /// The map tree.
     pub map: Map,
-    /// Whether the map tree has a stochastic switch (else its `u` is never drawn).
-    pub stochastic_switch: bool,
     /// Whether facet bumps apply.
     pub facet_bump: bool,
     /// Centre and radius of a sphere bounding the stone, the floor patch under it and the lights.
@@ -180,7 +178,6 @@ impl World {
             materials,
             albedo,
             map: scene.surface.map.clone(),
-            stochastic_switch: scene.effects.on(Effect::StochasticSwitch),
             facet_bump: scene.effects.on(Effect::FacetBump),
             bounds: (centre, radius),
         })
