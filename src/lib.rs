@@ -4,9 +4,10 @@
 //! layered BRDF model of Weidlich & Wilkie (SIGGRAPH Asia 2009 course "Exploring the Potential of
 //! Layered BRDF Models"). This crate holds the reflection models ([`bsdf`]), the colour type
 //! ([`color`]), deterministic random numbers ([`sampler`]), procedural solid textures and the map
-//! tree that picks a material per point ([`texture`]), shading frames ([`geometry`]), the recipe
-//! description format ([`recipe`]) and the runtime data it compiles into ([`scene`]), and the
-//! command-line front end ([`cli`]).
+//! tree that picks a material per point ([`texture`]), rays, shapes and shading frames
+//! ([`geometry`]), the recipe description format ([`recipe`]) and the runtime data it compiles into
+//! ([`scene`]), light sources ([`light`]), the path tracer ([`render`]), EXR and PNG files
+//! ([`image`]), and the command-line front end ([`cli`]).
 //!
 //! A coated Lambertian, evaluated by the default (Corrected) model:
 //!

@@ -6,6 +6,9 @@
 //! "Fast splittable pseudorandom number generators", OOPSLA 2014) used as a 64-bit mixer, and a
 //! counter-based stream built on it. `rand`'s generators are seeded streams, not keyed hashes of
 //! coordinates, which is why this small piece is our own.
+//!
+//! [`PixelSampler`] draws a render's numbers slot by slot: independent hashes, or Owen-scrambled
+//! Sobol' points ([`sobol`], Burley 2020), both pure functions of `(seed, pixel, sample, slot)`.
 
 pub mod pixel;
 pub mod sobol;
