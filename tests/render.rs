@@ -113,6 +113,13 @@ fn z_test(r: &Rendered, expected: impl Fn(u32, u32) -> Option<[f64; 3]>, what: &
     cells.len()
 }
 
+fn threads(n: usize) -> Control<'static> {
+    Control {
+        threads: Some(n),
+        ..Control::default()
+    }
+}
+
 fn furnace(albedo: f32) -> Scene {
     scene(&format!(
         r#"(materials: {{ "white": (base: Lambert(albedo: Gray({albedo}))) }},
@@ -324,20 +331,7 @@ fn light_only_bsdf_only_and_mis_agree() {
             );
         }
         // Per pixel: the difference of two independent estimates, z-tested.
-        let mis = &renders[0].1;
-        let npx = r.film.pixels.len();
-        let zc = z_crit(npx * 3);
-        for (a, b) in r.film.pixels.iter().zip(&mis.film.pixels) {
-            let (va, vb) = (a.variance_of_mean(), b.variance_of_mean());
-            for c in 0..3 {
-                let d = f64::from(a.mean()[c]) - f64::from(b.mean()[c]);
-                let sd = (f64::from(va[c]) + f64::from(vb[c])).sqrt();
-                assert!(
-                    d.abs() <= zc * sd + 1e-6,
-                    "{strategy:?}: pixel differs by {d} (sd {sd})"
-                );
-            }
-        }
+        assert_same_within_noise(r, &renders[0].1, &format!("{strategy:?} vs MIS"));
     }
     // MIS is the least noisy of the three over the image.
     let noise = |r: &Rendered| -> f64 {
@@ -358,31 +352,13 @@ fn renders_are_bit_identical_for_one_and_two_threads() {
     s.stage.render.width = 40;
     s.stage.render.height = 30;
     s.stage.render.spp = 6;
-    let one = run(
-        &s,
-        &Control {
-            threads: Some(1),
-            ..Control::default()
-        },
-    );
-    let two = run(
-        &s,
-        &Control {
-            threads: Some(2),
-            ..Control::default()
-        },
-    );
+    let one = run(&s, &threads(1));
+    let two = run(&s, &threads(2));
     assert_eq!(one.film, two.film);
     assert!(one.film.samples() == 40 * 30 * 6);
     // A different seed gives a different image.
     s.stage.render.seed = 1;
-    let other = run(
-        &s,
-        &Control {
-            threads: Some(2),
-            ..Control::default()
-        },
-    );
+    let other = run(&s, &threads(2));
     assert_ne!(one.film, other.film);
 }
 

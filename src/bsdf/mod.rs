@@ -282,20 +282,9 @@ pub fn power_heuristic(pdf_a: f32, pdf_b: f32) -> f32 {
 /// `None` only when the point lands on the disk's rim (`z = 0`, density 0).
 #[inline]
 pub fn sample_cosine_hemisphere(u: Vec2) -> Option<Vec3> {
-    let (ux, uy) = (2.0 * u.x - 1.0, 2.0 * u.y - 1.0);
-    let (r, phi) = if ux == 0.0 && uy == 0.0 {
-        (0.0, 0.0)
-    } else if ux.abs() > uy.abs() {
-        (ux, std::f32::consts::FRAC_PI_4 * (uy / ux))
-    } else {
-        (
-            uy,
-            std::f32::consts::FRAC_PI_2 - std::f32::consts::FRAC_PI_4 * (ux / uy),
-        )
-    };
-    let (x, y) = (r * phi.cos(), r * phi.sin());
-    let z = (1.0 - x * x - y * y).max(0.0).sqrt();
-    (z > 0.0).then(|| Vec3::new(x, y, z).normalize())
+    let d = crate::sampler::concentric_disc(u);
+    let z = (1.0 - d.x * d.x - d.y * d.y).max(0.0).sqrt();
+    (z > 0.0).then(|| Vec3::new(d.x, d.y, z).normalize())
 }
 
 /// Builds a unit direction from spherical angles in radians (`theta` from +z, `phi` from +x).

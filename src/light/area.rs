@@ -14,9 +14,10 @@
 use super::{LightSample, positive_or_zero};
 use crate::color::Spectrum;
 use crate::geometry::{Frame, Ray};
+use crate::sampler::concentric_disc;
 use crate::scene::stage::{AreaLight, LightShape};
 use glam::{DVec3, Vec2, Vec3};
-use std::f32::consts::{FRAC_PI_2, FRAC_PI_4, PI};
+use std::f32::consts::PI;
 
 /// Solid angle in steradians below which a rectangle is sampled by area instead of by solid angle:
 /// under it the spherical construction loses digits to cancellation while area sampling is already
@@ -323,21 +324,6 @@ impl SphericalRect {
         let [x, y, z] = self.axes;
         self.o + x * xu + y * yv + z * z0
     }
-}
-
-/// Shirley & Chiu's concentric map from `[0, 1)²` to the unit disc (area-preserving up to a
-/// constant: uniform in, uniform out).
-pub fn concentric_disc(u: Vec2) -> Vec2 {
-    let (a, b) = (2.0 * u.x - 1.0, 2.0 * u.y - 1.0);
-    if a == 0.0 && b == 0.0 {
-        return Vec2::ZERO;
-    }
-    let (r, phi) = if a.abs() > b.abs() {
-        (a, FRAC_PI_4 * (b / a))
-    } else {
-        (b, FRAC_PI_2 - FRAC_PI_4 * (a / b))
-    };
-    Vec2::new(r * phi.cos(), r * phi.sin())
 }
 
 #[cfg(test)]

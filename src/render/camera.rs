@@ -4,9 +4,9 @@
 //! downwards, pixel `(i, j)` covering `[i, i+1) × [j, j+1)`.
 
 use crate::geometry::Ray;
+use crate::sampler::concentric_disc;
 use crate::scene::stage::{Camera, Projection};
 use glam::{Vec2, Vec3};
-use std::f32::consts::FRAC_PI_4;
 
 /// A camera bound to an image size.
 #[derive(Clone, Copy, Debug)]
@@ -97,21 +97,6 @@ impl CameraRays {
     }
 }
 
-/// Shirley & Chiu's concentric map of the unit square onto the unit disc ("A Low Distortion Map
-/// Between Disk and Square", JGT 2(3), 1997): uniform by area, continuous, low distortion.
-pub fn concentric_disc(u: Vec2) -> Vec2 {
-    let a = 2.0 * u - Vec2::ONE;
-    if a.x == 0.0 && a.y == 0.0 {
-        return Vec2::ZERO;
-    }
-    let (r, theta) = if a.x.abs() > a.y.abs() {
-        (a.x, FRAC_PI_4 * (a.y / a.x))
-    } else {
-        (a.y, 2.0 * FRAC_PI_4 - FRAC_PI_4 * (a.x / a.y))
-    };
-    Vec2::new(r * theta.cos(), r * theta.sin())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -171,18 +156,5 @@ mod tests {
         let bottom = rays.ray(Vec2::new(10.0, 10.0), Vec2::ZERO);
         assert_eq!(top.dir, cam.forward);
         assert!(((top.origin - bottom.origin).length() - 2.0).abs() < 1e-5);
-    }
-
-    #[test]
-    fn concentric_disc_stays_in_the_disc_and_covers_it() {
-        let mut max_r = 0.0f32;
-        for i in 0..=32 {
-            for j in 0..=32 {
-                let d = concentric_disc(Vec2::new(i as f32 / 32.0, j as f32 / 32.0));
-                assert!(d.length() <= 1.0 + 1e-6);
-                max_r = max_r.max(d.length());
-            }
-        }
-        assert!(max_r > 0.999);
     }
 }

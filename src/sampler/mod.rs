@@ -12,8 +12,10 @@
 
 pub mod pixel;
 pub mod sobol;
+pub mod warp;
 
 pub use pixel::{PixelSampler, SamplerKind};
+pub use warp::concentric_disc;
 
 /// SplitMix64's finaliser: a bijective 64-bit mixer with full avalanche.
 #[inline]
