@@ -281,6 +281,15 @@ fn area_light_over_lambert_floor_matches_closed_form_irradiance() {
     assert!((c - 0.2215).abs() < 0.02, "{c}");
 }
 
+/// Sum over pixels of the variance of the pixel mean in channel `c` (a noise figure).
+fn total_variance(r: &Rendered, c: usize) -> f64 {
+    r.film
+        .pixels
+        .iter()
+        .map(|p| f64::from(p.variance_of_mean()[c]))
+        .sum()
+}
+
 /// Image mean and its standard error, per channel.
 fn image_mean(r: &Rendered) -> ([f64; 3], [f64; 3]) {
     let n = r.film.pixels.len() as f64;
@@ -334,13 +343,7 @@ fn light_only_bsdf_only_and_mis_agree() {
         assert_same_within_noise(r, &renders[0].1, &format!("{strategy:?} vs MIS"));
     }
     // MIS is the least noisy of the three over the image.
-    let noise = |r: &Rendered| -> f64 {
-        r.film
-            .pixels
-            .iter()
-            .map(|p| f64::from(p.variance_of_mean()[1]))
-            .sum()
-    };
+    let noise = |r: &Rendered| total_variance(r, 1);
     assert!(noise(&renders[0].1) < noise(&renders[1].1));
     assert!(noise(&renders[0].1) < noise(&renders[2].1));
 }
@@ -520,13 +523,7 @@ fn environment_map_is_importance_sampled_without_bias() {
     assert_same_within_noise(&mis, &bsdf, "env map: MIS vs BSDF only");
     assert_same_within_noise(&mis, &light, "env map: MIS vs light only");
     // Importance sampling the sun pays: MIS has far less noise than BSDF sampling alone.
-    let noise = |r: &Rendered| -> f64 {
-        r.film
-            .pixels
-            .iter()
-            .map(|p| f64::from(p.variance_of_mean()[0]))
-            .sum()
-    };
+    let noise = |r: &Rendered| total_variance(r, 0);
     assert!(
         noise(&mis) * 4.0 < noise(&bsdf),
         "{} vs {}",
