@@ -532,3 +532,35 @@ fn environment_map_is_importance_sampled_without_bias() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn depth_of_field_code_changes_nothing_when_the_aperture_is_zero() {
+    // The lens numbers are drawn whether or not the lens is used, so forcing the effect's code on
+    // for a pinhole camera renders bit-identically; with an aperture the image changes.
+    let text = |aperture: f32| {
+        format!(
+            r#"(materials: {{ "a": (coats: [(ior: 1.5, roughness: 3.0)], base: Lambert(albedo: Gray(0.5))) }},
+                surface: Material("a"),
+                stage: (camera: Perspective(from: (0.0, 2.6, 4.2), to: (0.0, 0.15, 0.0), fov: 30.0,
+                                            aperture: {aperture}, focus_distance: 2.0),
+                        render: (width: 24, height: 18, spp: 8)))"#
+        )
+    };
+    let pinhole = scene(&text(0.0));
+    assert!(!pinhole.effects.on(Effect::DepthOfField));
+    let world = World::new(&pinhole).unwrap();
+    let r = |dof: bool, s: &Scene| {
+        render(
+            &world,
+            &s.stage.camera,
+            dof,
+            &s.stage.render,
+            &Control::default(),
+        )
+        .film
+    };
+    assert_eq!(r(false, &pinhole), r(true, &pinhole));
+    let lens = scene(&text(0.2));
+    assert!(lens.effects.on(Effect::DepthOfField));
+    assert_ne!(r(true, &lens), r(false, &lens));
+}
