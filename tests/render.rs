@@ -6,6 +6,8 @@
 //! `N` pixels tested at family-wise significance α = 0.001 the Šidák bound per pixel is
 //! `α_i = 1 − (1 − α)^(1/N)`, and the test allows `|z|` up to the matching normal quantile
 //! (`z_crit`, computed below). Image-wide means are tested the same way with the summed variance.
+//! The analytic scenes use the independent sampler: its sample variance is an honest estimate of
+//! the error of the mean, where Sobol' stratification would make the z-tests conservative.
 
 use glam::{Vec2, Vec3};
 use lapidary::recipe::GemRecipe;
@@ -93,6 +95,7 @@ fn z_test(r: &Rendered, expected: impl Fn(u32, u32) -> Option<[f64; 3]>, what: &
         .filter_map(|(x, y)| expected(x, y).map(|e| (x, y, e)))
         .collect();
     let zc = z_crit(cells.len() * 3);
+    let (mut max_z, mut sum_e, mut sum_m) = (0.0f64, 0.0f64, 0.0f64);
     for &(x, y, e) in &cells {
         let p = &r.film.pixels[(y * w + x) as usize];
         let m = p.mean();
@@ -100,6 +103,11 @@ fn z_test(r: &Rendered, expected: impl Fn(u32, u32) -> Option<[f64; 3]>, what: &
         for c in 0..3 {
             let sd = f64::from(v[c]).sqrt();
             let diff = f64::from(m[c]) - e[c];
+            if sd > 0.0 {
+                max_z = max_z.max(diff.abs() / sd);
+            }
+            sum_e += e[c];
+            sum_m += f64::from(m[c]);
             // A zero-variance pixel must be exact to rounding.
             assert!(
                 diff.abs() <= zc * sd + 2e-5 * e[c].abs().max(1.0),
@@ -110,6 +118,13 @@ fn z_test(r: &Rendered, expected: impl Fn(u32, u32) -> Option<[f64; 3]>, what: &
             );
         }
     }
+    eprintln!(
+        "{what}: {} pixels, mean rendered {:.5} vs expected {:.5}, max |z| {max_z:.2} (limit \
+         {zc:.2})",
+        cells.len(),
+        sum_m / (3 * cells.len()) as f64,
+        sum_e / (3 * cells.len()) as f64
+    );
     cells.len()
 }
 
@@ -126,7 +141,7 @@ fn furnace(albedo: f32) -> Scene {
             surface: Material("white"),
             stage: (shape: Sphere(radius: 1.0), ground: Off, lights: [], environment: Constant(Gray(1.0)),
                     camera: Orthographic(from: (0.0, 0.0, 5.0), to: (0.0, 0.0, 0.0), height: 2.4),
-                    render: (width: 32, height: 32, spp: 64, max_depth: 8)))"#
+                    render: (sampler: Independent, width: 32, height: 32, spp: 64, max_depth: 8)))"#
     ))
 }
 
@@ -150,6 +165,21 @@ fn white_furnace_lambert_sphere_renders_its_albedo() {
             &format!("furnace albedo {albedo}"),
         );
         assert!(tested > 350, "{tested} pixels tested");
+        // The image-wide mean over the tested pixels, against its standard error.
+        let (mut m, mut v, mut n) = (0.0f64, 0.0f64, 0.0f64);
+        for y in 0..32 {
+            for x in 0..32 {
+                if inside_sphere(x, y, 32, 2.2) {
+                    let p = &r.film.pixels[(y * 32 + x) as usize];
+                    m += f64::from(p.mean()[0]);
+                    v += f64::from(p.variance_of_mean()[0]);
+                    n += 1.0;
+                }
+            }
+        }
+        let z = (m / n - f64::from(albedo)) / (v.sqrt() / n);
+        eprintln!("furnace albedo {albedo}: mean {:.5}, z {z:.2}", m / n);
+        assert!(z.abs() < z_crit(2), "furnace mean {} (z {z})", m / n);
         // Outside the sphere the camera sees the environment: exactly 1.
         let corner = r.film.pixels[0].mean();
         assert_eq!(corner.0, [1.0; 3]);
@@ -167,7 +197,7 @@ fn mirror_sphere_shows_the_environment() {
                     environment: Gradient(zenith: Rgb(0.2, 0.4, 1.0), horizon: Gray(1.0),
                                           nadir: Rgb(0.5, 0.3, 0.1)),
                     camera: Orthographic(from: (0.0, 0.0, 5.0), to: (0.0, 0.0, 0.0), height: 2.4),
-                    render: (width: 48, height: 48, spp: 16, filter: Box)))"#,
+                    render: (sampler: Independent, width: 48, height: 48, spp: 64, filter: Box)))"#,
     );
     let r = run(&s, &Control::default());
     let env = |d: Vec3| -> [f64; 3] {
@@ -205,8 +235,8 @@ fn mirror_sphere_shows_the_environment() {
     };
     let tested = z_test(&r, expected, "mirror sphere");
     assert!(tested > 1000);
-    // And closely: the mean relative error over the tested pixels is below 0.5 %, the worst 3 %
-    // (the pixel noise here is the environment varying across the pixel, up to 2.8 % sd).
+    // And closely: the mean relative error over the tested pixels is below 0.5 %, the worst 5 %
+    // (the pixel noise here is the environment varying across the pixel footprint).
     let (mut sum, mut worst) = (0.0f64, 0.0f64);
     for y in 0..n {
         for x in 0..n {
@@ -221,7 +251,7 @@ fn mirror_sphere_shows_the_environment() {
         }
     }
     assert!(
-        sum < 0.005 && worst < 0.03,
+        sum < 0.005 && worst < 0.05,
         "mean relative error {sum}, worst {worst}"
     );
 }
@@ -247,7 +277,7 @@ fn disc_over_floor(strategy_spp: u32) -> Scene {
                                   radiance: Gray(2.0))],
                     camera: Orthographic(from: (0.0, 1.0, 0.0), to: (0.0, 0.0, 0.0),
                                          up: (0.0, 0.0, -1.0), height: 3.0),
-                    render: (width: 24, height: 24, spp: {strategy_spp}, filter: Box)))"#
+                    render: (sampler: Independent, width: 24, height: 24, spp: {strategy_spp}, filter: Box)))"#
     ))
 }
 
@@ -307,13 +337,24 @@ fn image_mean(r: &Rendered) -> ([f64; 3], [f64; 3]) {
 
 #[test]
 fn light_only_bsdf_only_and_mis_agree() {
-    // The studio stage (three soft boxes, sky, floor) and a coated glossy stone: every estimator
-    // is unbiased, so per-pixel means agree within their noise.
+    // The studio's three soft boxes and sky over a coated glossy stone: every estimator is
+    // unbiased, so per-pixel means agree within their noise, and so do image means. The z-test
+    // needs each estimator's sample variance to be a fair estimate of its error. That fails where
+    // a strategy meets the light only a few times per pixel: a pixel short of rare hits looks both
+    // dim and quiet. It happens at silhouettes, where a few samples of the pixel graze the stone
+    // (BSDF-only on the soft boxes, light-only on the glossy reflection of the sky: |z| up to 5
+    // at 4096 spp there, ≤ 2 inside), so per-pixel tests skip pixels whose 5 × 5 neighbourhood
+    // sees more than one thing, and use 2048 spp so that hits are not rare elsewhere. The floor is off: with it, light
+    // reaches the floor through the stone (floor → stone → soft box), paths BSDF sampling alone
+    // finds so rarely that its sample variance underestimates its error (at 4096 spp under the
+    // test sky below: BSDF-only 20 % low on some floor pixels, |z| up to 6.8, while light-only
+    // and MIS agree to |z| ≤ 1.4), so the z-test would not be valid for it.
     let text = r#"(materials: { "glossy": (coats: [(ior: 1.5, roughness: 8.0, thickness: 0.5,
                                                     absorption: Rgb(0.1, 0.4, 0.8))],
                                           base: Lambert(albedo: Gray(0.6))) },
                    surface: Material("glossy"),
-                   stage: (render: (width: 24, height: 18, spp: 256, max_depth: 4)))"#;
+                   stage: (ground: Off,
+                           render: (sampler: Independent, width: 24, height: 18, spp: 2048, max_depth: 4)))"#;
     let s = scene(text);
     let renders: Vec<(Strategy, Rendered)> =
         [Strategy::Mis, Strategy::LightOnly, Strategy::BsdfOnly]
@@ -340,10 +381,26 @@ fn light_only_bsdf_only_and_mis_agree() {
             );
         }
         // Per pixel: the difference of two independent estimates, z-tested.
-        assert_same_within_noise(r, &renders[0].1, &format!("{strategy:?} vs MIS"));
+        let mis = &renders[0].1;
+        let n = compare_pixels(
+            r,
+            mis,
+            |k| interior(mis, k),
+            &format!("{strategy:?} vs MIS"),
+        );
+        assert!(n > 100, "{n} interior pixels");
     }
     // MIS is the least noisy of the three over the image.
     let noise = |r: &Rendered| total_variance(r, 1);
+    for (strategy, r) in &renders {
+        let (m, sd) = image_mean(r);
+        eprintln!(
+            "studio, {strategy:?}: image mean G {:.5} ± {:.5}, summed pixel variance {:.3e}",
+            m[1],
+            sd[1],
+            noise(r)
+        );
+    }
     assert!(noise(&renders[0].1) < noise(&renders[1].1));
     assert!(noise(&renders[0].1) < noise(&renders[2].1));
 }
@@ -417,18 +474,51 @@ fn no_dropped_samples_over_the_catalogue() {
 
 /// Per-pixel z-test of the difference of two independent renders of the same scene.
 fn assert_same_within_noise(a: &Rendered, b: &Rendered, what: &str) {
-    let zc = z_crit(a.film.pixels.len() * 3);
-    for (k, (p, q)) in a.film.pixels.iter().zip(&b.film.pixels).enumerate() {
+    compare_pixels(a, b, |_| true, what);
+}
+
+/// Whether every pixel within two pixels of pixel `k` saw the same thing first (material id):
+/// the pixel's filter footprint (Gaussian, radius 1.5) does not straddle a silhouette.
+fn interior(r: &Rendered, k: usize) -> bool {
+    let (w, h) = (r.film.width as i64, r.film.height as i64);
+    let (x, y) = (k as i64 % w, k as i64 / w);
+    let m = r.film.pixels[k].material;
+    (-2..=2).all(|dy| {
+        (-2..=2).all(|dx| {
+            let (u, v) = (x + dx, y + dy);
+            (0..w).contains(&u)
+                && (0..h).contains(&v)
+                && r.film.pixels[(v * w + u) as usize].material == m
+        })
+    })
+}
+
+/// Per-pixel z-test of the difference of two independent estimates over the pixels `keep`
+/// selects; returns how many were tested.
+fn compare_pixels(a: &Rendered, b: &Rendered, keep: impl Fn(usize) -> bool, what: &str) -> usize {
+    let tested: Vec<usize> = (0..a.film.pixels.len()).filter(|&k| keep(k)).collect();
+    let zc = z_crit(tested.len() * 3);
+    let mut max_z = 0.0f64;
+    for &k in &tested {
+        let (p, q) = (&a.film.pixels[k], &b.film.pixels[k]);
         let (vp, vq) = (p.variance_of_mean(), q.variance_of_mean());
         for c in 0..3 {
             let d = f64::from(p.mean()[c]) - f64::from(q.mean()[c]);
             let sd = (f64::from(vp[c]) + f64::from(vq[c])).sqrt();
+            if sd > 0.0 {
+                max_z = max_z.max(d.abs() / sd);
+            }
             assert!(
                 d.abs() <= zc * sd + 1e-5,
                 "{what}: pixel {k} channel {c} differs by {d} (sd {sd})"
             );
         }
     }
+    eprintln!(
+        "{what}: {} pixels, max |z| {max_z:.2} (limit {zc:.2})",
+        tested.len()
+    );
+    tested.len()
 }
 
 #[test]
@@ -438,7 +528,7 @@ fn a_cube_mesh_renders_like_the_slab_of_the_same_size() {
             r#"(materials: {{ "m": (coats: [(ior: 1.5, roughness: 6.0)], base: Lambert(albedo: Gray(0.4))) }},
                 surface: Material("m"),
                 stage: (shape: {shape}, transform: (rotate: (0.0, 30.0, 0.0), scale: 0.5),
-                        render: (width: 32, height: 24, spp: 64, seed: {seed})))"#
+                        render: (sampler: Independent, width: 32, height: 24, spp: 64, seed: {seed})))"#
         )
     };
     let mesh = run(
@@ -460,8 +550,12 @@ fn a_cube_mesh_renders_like_the_slab_of_the_same_size() {
 
 #[test]
 fn environment_map_is_importance_sampled_without_bias() {
-    // A 64 × 32 lat-long sky: dim blue with a bright warm "sun" of 8 × 4 pixels (≈ 0.3 sr, so
-    // BSDF sampling alone meets it often enough for its noise estimate to be trustworthy).
+    // A 64 × 32 lat-long sky: dim blue with a warm "sun" of 16 × 8 pixels (≈ 1.2 sr) 15–60 times
+    // brighter. It is large and not too bright so that BSDF sampling alone meets it often enough
+    // for its sample variance to be a fair error estimate: with an 8 × 4-pixel sun 100× the sky,
+    // points that see a sliver of it just above their horizon get about one BSDF hit in 2048
+    // samples, and a pixel with none is both dim and quiet (|z| up to 15 against MIS, while
+    // MIS and light-only agree to |z| 2.5; checked against brute-force integration of the map).
     let dir = std::env::temp_dir().join(format!("lapidary-envmap-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("sky.exr");
@@ -470,9 +564,9 @@ fn environment_map_is_importance_sampled_without_bias() {
     for y in 0..h {
         for x in 0..w {
             let k = (y * w + x) as usize;
-            let sun = (20..28).contains(&x) && (8..12).contains(&y);
+            let sun = (16..32).contains(&x) && (6..14).contains(&y);
             let v = if sun {
-                [40.0, 30.0, 20.0]
+                [6.0, 4.5, 3.0]
             } else {
                 [0.1, 0.2, 0.4]
             };
@@ -498,9 +592,9 @@ fn environment_map_is_importance_sampled_without_bias() {
     let text = format!(
         r#"(materials: {{ "m": (coats: [(ior: 1.5, roughness: 10.0)], base: Lambert(albedo: Gray(0.5))) }},
             surface: Material("m"),
-            stage: (shape: Sphere(radius: 1.0), lights: [],
+            stage: (shape: Sphere(radius: 1.0), lights: [], ground: Off,
                     environment: Map(file: {:?}, intensity: 1.0, rotate: 40.0),
-                    render: (width: 24, height: 18, spp: 256, max_depth: 3)))"#,
+                    render: (sampler: Independent, width: 24, height: 18, spp: 2048, max_depth: 3)))"#,
         path.display().to_string()
     );
     let s = scene(&text);
@@ -520,10 +614,17 @@ fn environment_map_is_importance_sampled_without_bias() {
             ..Control::default()
         },
     );
-    assert_same_within_noise(&mis, &bsdf, "env map: MIS vs BSDF only");
-    assert_same_within_noise(&mis, &light, "env map: MIS vs light only");
+    let inside = |k| interior(&mis, k);
+    assert!(compare_pixels(&mis, &bsdf, inside, "env map: MIS vs BSDF only") > 80);
+    assert!(compare_pixels(&mis, &light, inside, "env map: MIS vs light only") > 80);
     // Importance sampling the sun pays: MIS has far less noise than BSDF sampling alone.
     let noise = |r: &Rendered| total_variance(r, 0);
+    eprintln!(
+        "env map: summed pixel variance MIS {:.3e}, light only {:.3e}, BSDF only {:.3e}",
+        noise(&mis),
+        noise(&light),
+        noise(&bsdf)
+    );
     assert!(
         noise(&mis) * 4.0 < noise(&bsdf),
         "{} vs {}",
