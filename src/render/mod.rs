@@ -1,5 +1,5 @@
 //! The path tracer (DESIGN §6): camera rays, pixel filters, the integrator, the film, and the
-//! loop that renders a compiled [`Scene`] in passes of samples over tiles, in parallel.
+//! loop that renders a compiled [`Scene`](crate::scene::Scene) in passes of samples over tiles, in parallel.
 //!
 //! **Determinism.** Every random number is `hash(seed, pixel, sample, slot)` ([`PixelSampler`]);
 //! each pixel's samples are added in sample order by the one task that owns its tile in a pass,
