@@ -208,7 +208,7 @@ pub fn run(args: &RenderArgs) -> Result<bool> {
     bar.set_style(
         ProgressStyle::with_template(
             "{spinner} [{elapsed_precise}] {wide_bar} {human_pos}/{human_len} samples \
-             {per_sec} ETA {eta}",
+             {per_sec:0} ETA {eta}",
         )
         .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
