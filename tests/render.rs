@@ -10,6 +10,7 @@
 //! the error of the mean, where Sobol' stratification would make the z-tests conservative.
 
 use glam::{Vec2, Vec3};
+use lapidary::image::stats::{normal_quantile_two_sided, sidak};
 use lapidary::recipe::GemRecipe;
 use lapidary::render::{Control, Rendered, Strategy, World, render};
 use lapidary::scene::{Effect, Scene};
@@ -34,56 +35,9 @@ fn run(scene: &Scene, control: &Control) -> Rendered {
     )
 }
 
-/// Standard normal quantile `z` with `P(|Z| > z) = alpha` (bisection on erfc via a series-free
-/// bound is overkill: Acklam's rational approximation is accurate to 1e-9).
-fn z_two_sided(alpha: f64) -> f64 {
-    let p = 1.0 - alpha / 2.0;
-    // Acklam (2003) central/tail rational approximation of the normal quantile.
-    let a = [
-        -3.969683028665376e1,
-        2.209460984245205e2,
-        -2.759285104469687e2,
-        1.38357751867269e2,
-        -3.066479806614716e1,
-        2.506628277459239,
-    ];
-    let b = [
-        -5.447609879822406e1,
-        1.615858368580409e2,
-        -1.556989798598866e2,
-        6.680131188771972e1,
-        -1.328068155288572e1,
-    ];
-    let c = [
-        -7.784894002430293e-3,
-        -3.223964580411365e-1,
-        -2.400758277161838,
-        -2.549732539343734,
-        4.374664141464968,
-        2.938163982698783,
-    ];
-    let d = [
-        7.784695709041462e-3,
-        3.224671290700398e-1,
-        2.445134137142996,
-        3.754408661907416,
-    ];
-    if p > 0.97575 {
-        let q = (-2.0 * (1.0 - p).ln()).sqrt();
-        -(((((c[0] * q + c[1]) * q + c[2]) * q + c[3]) * q + c[4]) * q + c[5])
-            / ((((d[0] * q + d[1]) * q + d[2]) * q + d[3]) * q + 1.0)
-    } else {
-        let q = p - 0.5;
-        let r = q * q;
-        (((((a[0] * r + a[1]) * r + a[2]) * r + a[3]) * r + a[4]) * r + a[5]) * q
-            / (((((b[0] * r + b[1]) * r + b[2]) * r + b[3]) * r + b[4]) * r + 1.0)
-    }
-}
-
 /// The per-pixel critical |z| for `n` tests at family-wise α = 0.001 (Šidák).
 fn z_crit(n: usize) -> f64 {
-    let alpha_i = 1.0 - (1.0f64 - 0.001).powf(1.0 / n as f64);
-    z_two_sided(alpha_i)
+    normal_quantile_two_sided(sidak(0.001, n))
 }
 
 /// Per-pixel z-test of channel means against `expected(x, y)` (None: pixel not tested). Returns

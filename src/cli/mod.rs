@@ -3,9 +3,11 @@
 
 pub mod brdf;
 pub mod check;
+pub mod compare;
 pub mod info;
 pub mod map;
 pub mod plot;
+pub mod regress;
 pub mod render;
 
 use clap::{Parser, Subcommand};
@@ -41,6 +43,12 @@ pub enum Command {
     /// Path-trace a gem recipe to NAME.exr (colour, AOVs, metadata) and NAME.png. Ctrl-C or
     /// --time-limit stop early and write what was rendered, marked partial (Ctrl-C exits 130).
     Render(render::RenderArgs),
+    /// Compare a test render with a reference (EXR): RMSE, relMSE, MAE, PSNR and a per-pixel
+    /// z-test; exits 0 on pass, 1 on fail, 2 on unusable input.
+    Compare(compare::CompareArgs),
+    /// Run a folder of recipes against the reference EXRs beside them (NAME.ron + NAME.exr) and
+    /// print a table; --update makes the references. Exits as compare does.
+    Regress(regress::RegressArgs),
 }
 
 /// Parses the process arguments and runs; errors are printed as `error: …` and exit with 1.
@@ -55,6 +63,27 @@ pub fn run() -> ExitCode {
             Ok(true) => return ExitCode::from(130),
             Err(e) => Err(e),
         },
+        Command::Compare(args) => {
+            return match compare::run(&args) {
+                Ok(compare::Verdict::Pass) => ExitCode::SUCCESS,
+                Ok(compare::Verdict::Fail) => ExitCode::from(1),
+                Err(e) => {
+                    eprintln!("error: {e:#}");
+                    ExitCode::from(2)
+                }
+            };
+        }
+        Command::Regress(args) => {
+            return match regress::run(&args) {
+                Ok(regress::Outcome::Pass) => ExitCode::SUCCESS,
+                Ok(regress::Outcome::Fail) => ExitCode::from(1),
+                Ok(regress::Outcome::Unusable) => ExitCode::from(2),
+                Err(e) => {
+                    eprintln!("error: {e:#}");
+                    ExitCode::from(2)
+                }
+            };
+        }
         Command::Check(args) => match check::run(&args) {
             Ok(true) => Ok(()),
             Ok(false) => return ExitCode::from(1),

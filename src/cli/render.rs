@@ -93,7 +93,7 @@ pub enum StrategyArg {
     Bsdf,
 }
 
-fn parse_size(s: &str) -> Result<(u32, u32), String> {
+pub(crate) fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let err = || format!("`{s}`: expected WxH with each side in 1..=16384, e.g. 480x360");
     let (w, h) = s.split_once(['x', 'X']).ok_or_else(err)?;
     let (w, h): (u32, u32) = (
@@ -233,15 +233,7 @@ pub fn run(args: &RenderArgs) -> Result<bool> {
     bar.finish_and_clear();
     let was_interrupted = cancel.load(Ordering::SeqCst);
 
-    let meta = Metadata {
-        recipe: args.recipe.display().to_string(),
-        recipe_hash: scene.hash,
-        seed: r.seed,
-        spp: r.spp,
-        sampler: r.sampler.name().to_string(),
-        max_depth: r.max_depth,
-        materials: scene.surface.names.clone(),
-    };
+    let meta = Metadata::of(&args.recipe.display().to_string(), &scene);
     write_exr(&exr_path, &exr_image(&rendered, &meta))
         .with_context(|| format!("writing {}", exr_path.display()))?;
     if let Some(png) = &png_path {

@@ -22,11 +22,16 @@
 //! ```
 
 pub mod atomic;
+pub mod compare;
 pub mod exr;
+pub mod heatmap;
 pub mod png;
+pub mod stats;
 
 pub use self::atomic::write_atomically;
+pub use self::compare::{CompareError, Comparison, ZTest, compare};
 pub use self::exr::{RgbImage, read_exr, read_rgb, write_exr};
+pub use self::heatmap::write_heatmap;
 pub use self::png::{Curve, ToneMap, tone_map_pixel, write_png};
 
 use std::path::PathBuf;

@@ -40,6 +40,22 @@ pub struct Metadata {
     pub materials: Vec<String>,
 }
 
+impl Metadata {
+    /// The metadata of rendering `scene` (with its current render settings) from `recipe`.
+    pub fn of(recipe: &str, scene: &crate::scene::Scene) -> Metadata {
+        let r = &scene.stage.render;
+        Metadata {
+            recipe: recipe.to_string(),
+            recipe_hash: scene.hash,
+            seed: r.seed,
+            spp: r.spp,
+            sampler: r.sampler.name().to_string(),
+            max_depth: r.max_depth,
+            materials: scene.surface.names.clone(),
+        }
+    }
+}
+
 /// The EXR image of a render.
 pub fn exr_image(r: &Rendered, meta: &Metadata) -> ExrImage {
     let px = &r.film.pixels;

@@ -1,0 +1,213 @@
+//! `lapidary regress DIR`: a user's own regression suite. `DIR` holds recipes (`NAME.ron`) with
+//! their references beside them (`NAME.exr`, made once with `--update`). Each recipe is rendered
+//! at its reference's size, fast (default 64 spp, independent sampler, seed 7), and z-tested
+//! against the reference like `lapidary compare`; a table shows every result. Exit status: 0 all
+//! pass, 1 some fail, 2 unusable input (a recipe without reference, an unreadable reference, a
+//! recipe that does not compile, an empty folder).
+
+use crate::image::compare::{Comparison, compare};
+use crate::image::write_heatmap;
+use crate::image::{ExrImage, read_exr, write_exr};
+use crate::recipe::GemRecipe;
+use crate::render::{Control, Metadata, World, exr_image, render};
+use crate::sampler::SamplerKind;
+use crate::scene::Effect;
+use anyhow::{Result, anyhow, bail};
+use clap::Args;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Arguments of `lapidary regress`.
+#[derive(Debug, Args)]
+pub struct RegressArgs {
+    /// Folder of recipes (`NAME.ron`) with references beside them (`NAME.exr`).
+    pub dir: PathBuf,
+    /// Samples per pixel of the test renders.
+    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(2..=1_048_576))]
+    pub spp: u32,
+    /// Seed of the test renders (use one the references were not made with).
+    #[arg(long, default_value_t = 7)]
+    pub seed: u64,
+    /// Where failed tests write their render and heatmap.
+    #[arg(long, default_value = "regress-out")]
+    pub out: PathBuf,
+    /// Make (or remake) every reference instead of testing: `--ref-spp` samples, Sobol', seed
+    /// 1000, at the recipe's size or `--size`.
+    #[arg(long)]
+    pub update: bool,
+    /// Samples per pixel of references made by `--update`.
+    #[arg(long, default_value_t = 2048, value_parser = clap::value_parser!(u32).range(2..=1_048_576))]
+    pub ref_spp: u32,
+    /// Size of references made by `--update` (default: the recipe's).
+    #[arg(long, value_parser = super::render::parse_size)]
+    pub size: Option<(u32, u32)>,
+    /// Worker threads (default: one per core).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub threads: Option<u32>,
+}
+
+/// Outcome of `lapidary regress`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Outcome {
+    /// Every recipe passed (or every reference was written).
+    Pass,
+    /// Some recipe failed its comparison.
+    Fail,
+    /// Some input could not be used.
+    Unusable,
+}
+
+/// Renders `recipe` with the given overrides into an EXR image.
+fn render_recipe(
+    recipe: &Path,
+    size: Option<(u32, u32)>,
+    spp: u32,
+    seed: u64,
+    sampler: SamplerKind,
+    threads: Option<u32>,
+) -> Result<ExrImage> {
+    let gem = GemRecipe::load(recipe).map_err(|e| anyhow!("{e}"))?;
+    let mut scene = gem.compile().map_err(|e| anyhow!("{e}"))?;
+    let r = &mut scene.stage.render;
+    if let Some((w, h)) = size {
+        r.width = w;
+        r.height = h;
+    }
+    r.spp = spp;
+    r.seed = seed;
+    r.sampler = sampler;
+    let world = World::new(&scene).map_err(|e| anyhow!("{}: {e}", recipe.display()))?;
+    let control = Control {
+        threads: threads.map(|t| t as usize),
+        ..Control::default()
+    };
+    let rendered = render(
+        &world,
+        &scene.stage.camera,
+        scene.effects.on(Effect::DepthOfField),
+        &scene.stage.render,
+        &control,
+    );
+    Ok(exr_image(
+        &rendered,
+        &Metadata::of(&recipe.display().to_string(), &scene),
+    ))
+}
+
+/// The recipes in `dir`, sorted.
+fn recipes(dir: &Path) -> Result<Vec<PathBuf>> {
+    let mut out: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map_err(|e| anyhow!("{}: {e}", dir.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "ron"))
+        .collect();
+    out.sort();
+    if out.is_empty() {
+        bail!("{}: no recipes (*.ron) in this folder", dir.display());
+    }
+    Ok(out)
+}
+
+/// One table row.
+fn row(name: &str, c: &Comparison, spp: u32, secs: f64) -> String {
+    let (pass, max_z) = match &c.ztest {
+        Some(z) => (
+            format!("{:.2} %", 100.0 * z.pass_fraction),
+            format!("{:.2}", z.max_abs_z),
+        ),
+        None => ("—".to_string(), "—".to_string()),
+    };
+    format!(
+        "{name:<24} {:>9} {spp:>6} {pass:>10} {max_z:>7} {:>9.2e} {:>8.1} {:>6.1} s  {}",
+        format!("{}x{}", c.width, c.height),
+        c.rel_mse,
+        c.psnr,
+        secs,
+        if c.passed { "pass" } else { "FAIL" }
+    )
+}
+
+/// Runs `lapidary regress`.
+pub fn run(args: &RegressArgs) -> Result<Outcome> {
+    let list = recipes(&args.dir)?;
+    let mut outcome = Outcome::Pass;
+    if args.update {
+        for recipe in &list {
+            let img = render_recipe(
+                recipe,
+                args.size,
+                args.ref_spp,
+                1000,
+                SamplerKind::Sobol,
+                args.threads,
+            )?;
+            let out = recipe.with_extension("exr");
+            write_exr(&out, &img)?;
+            println!(
+                "{}: reference written ({} spp)",
+                out.display(),
+                args.ref_spp
+            );
+        }
+        return Ok(outcome);
+    }
+    println!(
+        "{:<24} {:>9} {:>6} {:>10} {:>7} {:>9} {:>8} {:>8}  verdict",
+        "recipe", "size", "spp", "pixels ok", "max |z|", "relMSE", "PSNR dB", "time"
+    );
+    for recipe in &list {
+        let name = recipe
+            .file_stem()
+            .unwrap_or_default()
+            .to_string_lossy()
+            .into_owned();
+        let ref_path = recipe.with_extension("exr");
+        let reference = match read_exr(&ref_path) {
+            Ok(r) => r,
+            Err(e) => {
+                println!("{name:<24} unusable: {e} (make it with --update)");
+                outcome = Outcome::Unusable;
+                continue;
+            }
+        };
+        let start = Instant::now();
+        let test = match render_recipe(
+            recipe,
+            Some((reference.width, reference.height)),
+            args.spp,
+            args.seed,
+            SamplerKind::Independent,
+            args.threads,
+        ) {
+            Ok(t) => t,
+            Err(e) => {
+                println!("{name:<24} unusable: {e}");
+                outcome = Outcome::Unusable;
+                continue;
+            }
+        };
+        let secs = start.elapsed().as_secs_f64();
+        let c = match compare(&test, &reference) {
+            Ok(c) => c,
+            Err(e) => {
+                println!("{name:<24} unusable: {e}");
+                outcome = Outcome::Unusable;
+                continue;
+            }
+        };
+        println!("{}", row(&name, &c, args.spp, secs));
+        if !c.passed {
+            std::fs::create_dir_all(&args.out)
+                .map_err(|e| anyhow!("{}: {e}", args.out.display()))?;
+            let t = args.out.join(format!("{name}-test.exr"));
+            let h = args.out.join(format!("{name}-heatmap.png"));
+            write_exr(&t, &test)?;
+            write_heatmap(&h, &c)?;
+            println!("    wrote {} and {}", t.display(), h.display());
+            if outcome == Outcome::Pass {
+                outcome = Outcome::Fail;
+            }
+        }
+    }
+    Ok(outcome)
+}
