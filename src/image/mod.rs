@@ -24,6 +24,7 @@
 pub mod atomic;
 pub mod compare;
 pub mod exr;
+pub mod flip;
 pub mod heatmap;
 pub mod png;
 pub mod stats;
