@@ -119,7 +119,7 @@ fn identical_images_pass_with_zero_error() {
         assert_eq!(field(&report, label).parse::<f64>(), Ok(0.0), "{report}");
     }
     assert!(field(&report, "PSNR").starts_with("inf"), "{report}");
-    assert!(field(&report, "FLIP").contains("not computed"), "{report}");
+    assert!(field(&report, "FLIP").starts_with("0.0000 "), "{report}");
     assert!(field(&report, "z-test").starts_with("100.00% of 768 pixels pass"));
     assert_eq!(field(&report, "verdict"), "PASS");
 }
@@ -175,6 +175,13 @@ fn ten_percent_brighter_fails_and_still_writes_the_heatmap() {
     );
     let png = image::open(s.path("diff.png")).unwrap();
     assert_eq!((png.width(), png.height()), (32, 24));
+    // FLIP sees a 10 % brighter image as a small but clear perceptual difference.
+    let flip: f64 = field(&report, "FLIP")
+        .split_whitespace()
+        .next()
+        .and_then(|v| v.parse().ok())
+        .expect("a FLIP value");
+    assert!(flip > 0.005 && flip < 0.2, "FLIP {flip}");
 }
 
 #[test]

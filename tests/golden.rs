@@ -113,11 +113,12 @@ fn golden_renders_match_their_references() {
         let c = compare(&test, &reference).unwrap_or_else(|e| panic!("{name}: {e}"));
         let z = c.ztest.as_ref().expect("references carry variance");
         eprintln!(
-            "{name}: {:.2} % of pixels pass (max |z| {:.2}, limit {:.2}), relMSE {:.2e}",
+            "{name}: {:.2} % of pixels pass (max |z| {:.2}, limit {:.2}), relMSE {:.2e}, FLIP {:.4}",
             100.0 * z.pass_fraction,
             z.max_abs_z,
             z.z_crit,
-            c.rel_mse
+            c.rel_mse,
+            c.flip
         );
         if !c.passed {
             failures.push(evidence(name, &test, &reference, &c));

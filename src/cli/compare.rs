@@ -116,7 +116,7 @@ fn report(test: &Path, reference: &Path, c: &Comparison) -> String {
     let _ = writeln!(out, "  relMSE    {:.3e}", c.rel_mse);
     let _ = writeln!(out, "  MAE       {:.3e}", c.mae);
     let _ = writeln!(out, "  PSNR      {psnr}");
-    let _ = writeln!(out, "  FLIP      not computed (not implemented yet)");
+    let _ = writeln!(out, "  FLIP      {:.4} (HDR-FLIP mean, 67 px/°)", c.flip);
     if c.non_finite_pixels > 0 {
         let _ = writeln!(
             out,

@@ -155,6 +155,9 @@ pub struct Comparison {
     pub psnr: f64,
     /// The reference's largest finite channel value used as PSNR's peak (1 if not positive).
     pub peak: f64,
+    /// Mean HDR-FLIP error in [0, 1] at 67 pixels per degree ([`super::flip::hdr_flip`];
+    /// Andersson et al. 2020, 2021): a perceptual difference, reported, not part of the verdict.
+    pub flip: f64,
     /// Pixels with a NaN or infinite R, G or B in either image (always failures).
     pub non_finite_pixels: usize,
     /// The z-test, `None` when it could not run (see `ztest_skipped`).
@@ -313,6 +316,22 @@ pub fn compare(test: &ExrImage, reference: &ExrImage) -> Result<Comparison, Comp
         Some(z) => z.passed,
         None => rel_mse <= REL_MSE_THRESHOLD && non_finite_pixels == 0,
     };
+    let rgb = |p: &Planes| -> Vec<[f32; 3]> {
+        (0..n)
+            .map(|i| [p.rgb[0][i], p.rgb[1][i], p.rgb[2][i]])
+            .collect()
+    };
+    let flip = f64::from(
+        super::flip::hdr_flip(
+            &rgb(&t),
+            &rgb(&r),
+            test.width,
+            test.height,
+            super::flip::DEFAULT_PPD,
+        )
+        .flip
+        .mean,
+    );
     Ok(Comparison {
         width: test.width,
         height: test.height,
@@ -321,6 +340,7 @@ pub fn compare(test: &ExrImage, reference: &ExrImage) -> Result<Comparison, Comp
         mae,
         psnr,
         peak,
+        flip,
         non_finite_pixels,
         ztest,
         ztest_skipped,
@@ -459,6 +479,7 @@ mod tests {
         let c = compare(&img, &img).unwrap();
         assert_eq!((c.rmse, c.rel_mse, c.mae), (0.0, 0.0, 0.0));
         assert_eq!(c.psnr, f64::INFINITY);
+        assert_eq!(c.flip, 0.0);
         assert_eq!(c.peak, 2.0);
         let z = c.ztest.as_ref().unwrap();
         assert_eq!((z.failed_pixels, z.pixels, z.tested_channels), (0, 4, 6));
