@@ -65,16 +65,7 @@ pub fn write_heatmap(path: &Path, c: &Comparison) -> Result<(), ImageError> {
             }
         })
         .collect();
-    let img = ::image::RgbImage::from_raw(c.width, c.height, bytes)
-        .ok_or_else(|| ImageError::write(path, "pixel buffer size"))?;
-    super::atomic::replace_with(
-        path,
-        |tmp| {
-            img.save_with_format(tmp, ::image::ImageFormat::Png)
-                .map_err(|e| ImageError::write(path, e))
-        },
-        ImageError::write,
-    )
+    super::png::write_rgb8(path, c.width, c.height, bytes)
 }
 
 #[cfg(test)]

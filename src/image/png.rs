@@ -99,6 +99,11 @@ pub fn write_png(
         });
     }
     let bytes: Vec<u8> = rgb.iter().flat_map(|&p| tone_map_pixel(p, tm)).collect();
+    write_rgb8(path, width, height, bytes)
+}
+
+/// Writes 8-bit RGB bytes (row-major, top row first) as a PNG, atomically.
+pub fn write_rgb8(path: &Path, width: u32, height: u32, bytes: Vec<u8>) -> Result<(), ImageError> {
     let img = ::image::RgbImage::from_raw(width, height, bytes)
         .ok_or_else(|| ImageError::write(path, "pixel buffer size"))?;
     super::atomic::replace_with(
