@@ -3,8 +3,11 @@
 //! status 2 with a message for unusable input, the relMSE verdict without variance, the heatmap.
 
 use lapidary::image::{Channel, ExrImage, read_exr, write_exr};
-use std::path::PathBuf;
 use std::process::{Command, Output, Stdio};
+
+#[path = "common/scratch.rs"]
+mod scratch;
+use scratch::{Scratch, text};
 
 /// A coated grey Lambertian filling a 32×24 image; the independent sampler keeps the per-pixel
 /// sample variances honest for the z-test.
@@ -16,24 +19,7 @@ fn recipe(ior: f32) -> String {
     )
 }
 
-/// A fresh directory per test, removed when the test passes (kept when it fails).
-struct Scratch(PathBuf);
-
 impl Scratch {
-    fn new(test: &str) -> Self {
-        let dir = std::env::temp_dir().join(format!(
-            "lapidary-cli-compare-{test}-{}",
-            std::process::id()
-        ));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        Scratch(dir)
-    }
-
-    fn path(&self, name: &str) -> PathBuf {
-        self.0.join(name)
-    }
-
     /// Renders the scene with coat `ior` at `spp` and `seed` to `name`.
     fn render(&self, name: &str, ior: f32, spp: u32, seed: u64) {
         let ron = self.path(&format!("{name}.ron"));
@@ -66,20 +52,6 @@ impl Scratch {
     }
 }
 
-impl Drop for Scratch {
-    fn drop(&mut self) {
-        if std::thread::panicking() {
-            eprintln!("kept {} for inspection", self.0.display());
-        } else {
-            let _ = std::fs::remove_dir_all(&self.0);
-        }
-    }
-}
-
-fn text(b: &[u8]) -> String {
-    String::from_utf8_lossy(b).into_owned()
-}
-
 /// Asserts the exit code and returns stdout.
 fn status(out: &Output, code: i32) -> String {
     assert_eq!(
@@ -107,7 +79,7 @@ fn exr(s: &Scratch, name: &str) -> ExrImage {
 
 #[test]
 fn identical_images_pass_with_zero_error() {
-    let s = Scratch::new("identical");
+    let s = Scratch::new("cli-compare", "identical");
     s.render("ref.exr", 1.5, 16, 0);
     let report = status(&s.compare("ref.exr", "ref.exr", &[]), 0);
     assert!(report.starts_with(&format!(
@@ -126,7 +98,7 @@ fn identical_images_pass_with_zero_error() {
 
 #[test]
 fn low_spp_render_passes_against_a_high_spp_reference_and_writes_a_heatmap() {
-    let s = Scratch::new("pass");
+    let s = Scratch::new("cli-compare", "pass");
     s.render("ref.exr", 1.5, 1024, 0);
     s.render("test.exr", 1.5, 64, 3);
     let report = status(
@@ -147,7 +119,7 @@ fn low_spp_render_passes_against_a_high_spp_reference_and_writes_a_heatmap() {
 
 #[test]
 fn changed_ior_fails() {
-    let s = Scratch::new("ior");
+    let s = Scratch::new("cli-compare", "ior");
     s.render("ref.exr", 1.5, 1024, 0);
     s.render("test.exr", 1.8, 256, 3);
     let report = status(&s.compare("test.exr", "ref.exr", &[]), 1);
@@ -156,7 +128,7 @@ fn changed_ior_fails() {
 
 #[test]
 fn ten_percent_brighter_fails_and_still_writes_the_heatmap() {
-    let s = Scratch::new("gain");
+    let s = Scratch::new("cli-compare", "gain");
     s.render("ref.exr", 1.5, 1024, 0);
     let mut img = exr(&s, "ref.exr");
     for c in img
@@ -186,7 +158,7 @@ fn ten_percent_brighter_fails_and_still_writes_the_heatmap() {
 
 #[test]
 fn unusable_inputs_exit_2_naming_the_file() {
-    let s = Scratch::new("unusable");
+    let s = Scratch::new("cli-compare", "unusable");
     let rgb = |w: u32, h: u32, names: &[&str]| ExrImage {
         width: w,
         height: h,
@@ -225,7 +197,7 @@ fn unusable_inputs_exit_2_naming_the_file() {
 #[test]
 fn without_variance_the_verdict_comes_from_rel_mse() {
     use exr::prelude::{f16, write_rgb_file};
-    let s = Scratch::new("novariance");
+    let s = Scratch::new("cli-compare", "novariance");
     let value = |x: usize, y: usize, gain: f32| f16::from_f32(gain * (0.1 + 0.01 * (x + y) as f32));
     for (name, gain) in [("ref.exr", 1.0), ("same.exr", 1.0), ("bright.exr", 1.1)] {
         write_rgb_file(s.path(name), 8, 4, |x, y| {

@@ -1,37 +1,18 @@
 //! `lapidary regress DIR` end to end: making references with `--update`, a passing suite, a
 //! failing recipe (one IOR changed) with its evidence written, and unusable input.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output};
+
+#[path = "common/scratch.rs"]
+mod scratch;
+use scratch::{Scratch, text};
 
 const RECIPE: &str = r#"(
     materials: { "a": (coats: [(ior: 1.5, roughness: 8.0)], base: Lambert(albedo: Gray(0.5))) },
     surface: Material("a"),
     stage: (ground: Off),
 )"#;
-
-struct Scratch(PathBuf);
-
-impl Scratch {
-    fn new(name: &str) -> Scratch {
-        let dir =
-            std::env::temp_dir().join(format!("lapidary-regress-{name}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        Scratch(dir)
-    }
-    fn path(&self, f: &str) -> PathBuf {
-        self.0.join(f)
-    }
-}
-
-impl Drop for Scratch {
-    fn drop(&mut self) {
-        if !std::thread::panicking() {
-            let _ = std::fs::remove_dir_all(&self.0);
-        }
-    }
-}
 
 fn regress(dir: &Path, extra: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_lapidary"))
@@ -43,13 +24,9 @@ fn regress(dir: &Path, extra: &[&str]) -> Output {
         .expect("run lapidary")
 }
 
-fn text(b: &[u8]) -> String {
-    String::from_utf8_lossy(b).into_owned()
-}
-
 #[test]
 fn a_suite_passes_fails_and_reports_unusable_input() {
-    let s = Scratch::new("suite");
+    let s = Scratch::new("regress", "suite");
     let suite = s.path("suite");
     std::fs::create_dir_all(&suite).unwrap();
     std::fs::write(suite.join("coated.ron"), RECIPE).unwrap();
@@ -103,7 +80,7 @@ fn a_suite_passes_fails_and_reports_unusable_input() {
 
 #[test]
 fn an_empty_or_missing_folder_is_an_error() {
-    let s = Scratch::new("empty");
+    let s = Scratch::new("regress", "empty");
     std::fs::create_dir_all(s.path("suite")).unwrap();
     let out = regress(&s.0, &[]);
     assert_eq!(out.status.code(), Some(2));

@@ -2,8 +2,12 @@
 //! metadata, determinism, atomic replacement, argument errors, `--time-limit` and Ctrl-C.
 
 use lapidary::image::{ExrImage, read_exr};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output, Stdio};
+
+#[path = "common/scratch.rs"]
+mod scratch;
+use scratch::{Scratch, text};
 use std::time::{Duration, Instant};
 
 const SUNSTONE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/gems/sunstone.ron");
@@ -33,48 +37,6 @@ const CHANNELS: [&str; 15] = [
     "material.Y",
 ];
 
-/// A fresh directory per test, removed when the test passes (kept for inspection when it fails).
-struct Scratch(PathBuf);
-
-impl Scratch {
-    fn new(test: &str) -> Self {
-        let dir =
-            std::env::temp_dir().join(format!("lapidary-cli-render-{test}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        Scratch(dir)
-    }
-
-    fn path(&self, name: &str) -> PathBuf {
-        self.0.join(name)
-    }
-
-    /// `name` as an absolute path string, for arguments.
-    fn arg(&self, name: &str) -> String {
-        self.path(name).to_str().unwrap().to_owned()
-    }
-
-    /// The directory's entries, sorted.
-    fn files(&self) -> Vec<String> {
-        let mut v: Vec<String> = std::fs::read_dir(&self.0)
-            .unwrap()
-            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-            .collect();
-        v.sort();
-        v
-    }
-}
-
-impl Drop for Scratch {
-    fn drop(&mut self) {
-        if std::thread::panicking() {
-            eprintln!("kept {} for inspection", self.0.display());
-        } else {
-            let _ = std::fs::remove_dir_all(&self.0);
-        }
-    }
-}
-
 /// Runs `lapidary render ARGS…` in `dir`.
 fn render(dir: &Scratch, args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_lapidary"))
@@ -84,10 +46,6 @@ fn render(dir: &Scratch, args: &[&str]) -> Output {
         .stdin(Stdio::null())
         .output()
         .expect("binary runs")
-}
-
-fn text(b: &[u8]) -> String {
-    String::from_utf8_lossy(b).into_owned()
 }
 
 /// Asserts a zero exit and returns stdout.
@@ -138,7 +96,7 @@ fn summary_paths(summary: &str) -> u64 {
 
 #[test]
 fn default_outputs_are_named_after_the_recipe_in_the_current_directory() {
-    let dir = Scratch::new("defaults");
+    let dir = Scratch::new("cli-render", "defaults");
     let mut args = vec![SUNSTONE];
     args.extend(SMALL);
     let out = render(&dir, &args);
@@ -184,7 +142,7 @@ fn default_outputs_are_named_after_the_recipe_in_the_current_directory() {
 
 #[test]
 fn exr_has_every_channel_finite_and_the_metadata() {
-    let dir = Scratch::new("exr");
+    let dir = Scratch::new("cli-render", "exr");
     let run = |gem: &str, out: &str| {
         let mut args = vec![gem, "-o", out, "--no-png"];
         args.extend(SMALL);
@@ -281,7 +239,7 @@ fn exr_has_every_channel_finite_and_the_metadata() {
 
 #[test]
 fn output_and_png_paths_are_honoured_and_no_png_writes_none() {
-    let dir = Scratch::new("paths");
+    let dir = Scratch::new("cli-render", "paths");
     std::fs::create_dir(dir.path("out")).unwrap();
     let mut args = vec![SUNSTONE, "-o", "out/x.exr", "--png", "y.png"];
     args.extend(SMALL);
@@ -329,7 +287,7 @@ fn output_and_png_paths_are_honoured_and_no_png_writes_none() {
 
 #[test]
 fn threads_do_not_change_the_image_but_seed_and_sampler_do() {
-    let dir = Scratch::new("determinism");
+    let dir = Scratch::new("cli-render", "determinism");
     let run = |out: &str, extra: &[&str]| {
         let mut args = vec![SUNSTONE, "-o", out, "--no-png"];
         args.extend(SMALL);
@@ -383,7 +341,7 @@ fn threads_do_not_change_the_image_but_seed_and_sampler_do() {
 
 #[test]
 fn a_failed_run_never_replaces_a_good_file() {
-    let dir = Scratch::new("atomic");
+    let dir = Scratch::new("cli-render", "atomic");
     let mut args = vec![SUNSTONE, "-o", "good.exr", "--no-png"];
     args.extend(SMALL);
     ok(&render(&dir, &args));
@@ -450,7 +408,7 @@ fn a_failed_run_never_replaces_a_good_file() {
 
 #[test]
 fn bad_arguments_name_the_allowed_values() {
-    let dir = Scratch::new("args");
+    let dir = Scratch::new("cli-render", "args");
     for (args, wanted) in [
         (&["--size", "0x10"][..], "1..=16384"),
         (&["--size", "16385x10"], "1..=16384"),
@@ -494,7 +452,7 @@ fn bad_arguments_name_the_allowed_values() {
 /// `--exposure -31`, naming the range (it once said "unexpected argument '-1' found").
 #[test]
 fn negative_time_limit_as_a_separate_word_names_the_range() {
-    let dir = Scratch::new("negative-time");
+    let dir = Scratch::new("cli-render", "negative-time");
     let out = render(&dir, &[SUNSTONE, "--time-limit", "-1"]);
     let err = text(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
@@ -503,7 +461,7 @@ fn negative_time_limit_as_a_separate_word_names_the_range() {
 
 #[test]
 fn time_limit_stops_early_and_writes_a_partial_image() {
-    let dir = Scratch::new("time-limit");
+    let dir = Scratch::new("cli-render", "time-limit");
     let mut args = vec![SUNSTONE, "--time-limit", "0.3"];
     args.extend(LONG);
     let start = Instant::now();
@@ -555,7 +513,7 @@ fn handler_installed(pid: u32, since: Instant) -> bool {
 #[cfg(unix)]
 #[test]
 fn ctrl_c_writes_a_partial_image_and_exits_130() {
-    let dir = Scratch::new("ctrl-c");
+    let dir = Scratch::new("cli-render", "ctrl-c");
     let mut args = vec!["render", SUNSTONE, "-o", "c.exr"];
     args.extend(LONG);
     let child = Command::new(env!("CARGO_BIN_EXE_lapidary"))

@@ -73,18 +73,9 @@ pub(crate) fn normal_p(z: f64) -> f64 {
     chi2_p_value(z * z, 1)
 }
 
-/// The `z` with two-sided normal tail `alpha` (bisection on [`normal_p`]).
+/// The `z` with two-sided normal tail `alpha` (the library's quantile, `image::stats`).
 pub(crate) fn z_critical(alpha: f64) -> f64 {
-    let (mut lo, mut hi) = (0.0, 40.0);
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + hi);
-        if normal_p(mid) > alpha {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    0.5 * (lo + hi)
+    lapidary::image::stats::normal_quantile_two_sided(alpha)
 }
 
 /// Exact two-sided binomial p-value of `k` successes in `n` trials of probability `p`: twice the
