@@ -23,12 +23,18 @@ pub struct InfoArgs {
     /// Points sampled on the stone's surface for the material shares.
     #[arg(long, default_value_t = 20_000, value_parser = clap::value_parser!(u32).range(100..=10_000_000))]
     pub points: u32,
+    /// Accuracy knobs (show what they switch).
+    #[command(flatten)]
+    pub knobs: super::knobs::KnobArgs,
 }
 
 /// Runs `lapidary info`.
 pub fn run(args: &InfoArgs) -> Result<()> {
     let recipe = GemRecipe::load(&args.recipe).map_err(|e| anyhow!("{e}"))?;
-    let scene = recipe.compile().map_err(|e| anyhow!("{e}"))?;
+    let mut scene = recipe.compile().map_err(|e| anyhow!("{e}"))?;
+    args.knobs
+        .apply(&mut scene)
+        .map_err(|e| anyhow!("{}: {e}", args.recipe.display()))?;
     print!("{}", describe(&recipe, &scene, args.points));
     Ok(())
 }
@@ -281,24 +287,32 @@ pub fn describe(recipe: &GemRecipe, scene: &Scene, points: u32) -> String {
     // Effects.
     let _ = writeln!(o, "\neffects:");
     for e in Effect::ALL {
-        match scene.effects.reason(e) {
-            Some((why, n)) => {
-                let more = if n > 1 {
-                    format!(" (+{} more)", n - 1)
-                } else {
-                    String::new()
-                };
-                let _ = writeln!(o, "  on   {:<24} {why}{more}", e.name());
-            }
-            None => {
-                let note = if e.implemented() {
-                    format!("needs {}", e.trigger())
-                } else {
-                    format!("slot for later work (will need {})", e.trigger())
-                };
-                let _ = writeln!(o, "  off  {:<24} {note}", e.name());
-            }
-        }
+        let called = scene.effects.reason(e).map(|(why, n)| {
+            let more = if n > 1 {
+                format!(" (+{} more)", n - 1)
+            } else {
+                String::new()
+            };
+            format!("{why}{more}")
+        });
+        let state = if scene.effects.on(e) { "on " } else { "off" };
+        let line = match (scene.effects.forced(e), scene.effects.forced_by(e), called) {
+            (Some(on), Some(by), called) => format!(
+                "forced {} by {by}; {}",
+                if on { "on" } else { "off" },
+                called.map_or_else(
+                    || "the scene does not call for it".to_string(),
+                    |c| format!("called for by {c}")
+                )
+            ),
+            (_, _, Some(c)) => c,
+            _ if e.implemented() => format!("needs {}", e.trigger()),
+            _ => format!("slot for later work (will need {})", e.trigger()),
+        };
+        let _ = writeln!(o, "  {state}  {:<24} {line}", e.name());
+    }
+    if !scene.accuracy.is_default() {
+        let _ = writeln!(o, "\naccuracy knobs: {}", scene.accuracy);
     }
     o
 }

@@ -5,6 +5,7 @@ pub mod brdf;
 pub mod check;
 pub mod compare;
 pub mod info;
+pub mod knobs;
 pub mod map;
 pub mod plot;
 pub mod regress;

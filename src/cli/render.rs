@@ -59,6 +59,9 @@ pub struct RenderArgs {
     /// Direct-light estimators (for testing the integrator; `mis` is always best).
     #[arg(long, value_enum, default_value_t = StrategyArg::Mis)]
     pub strategy: StrategyArg,
+    /// Accuracy knobs (override the recipe's).
+    #[command(flatten)]
+    pub knobs: super::knobs::KnobArgs,
     /// No progress bar and no summary.
     #[arg(short, long)]
     pub quiet: bool,
@@ -196,6 +199,9 @@ pub fn run(args: &RenderArgs) -> Result<bool> {
     let recipe = GemRecipe::load(&args.recipe).map_err(|e| anyhow!("{e}"))?;
     let mut scene = recipe.compile().map_err(|e| anyhow!("{e}"))?;
     settings(args, &mut scene);
+    args.knobs
+        .apply(&mut scene)
+        .map_err(|e| anyhow!("{}: {e}", args.recipe.display()))?;
     let world = World::new(&scene).map_err(|e| anyhow!("{}: {e}", args.recipe.display()))?;
     let r = scene.stage.render;
 
@@ -322,6 +328,9 @@ fn summary(
             effects.join(", ")
         }
     );
+    if !scene.accuracy.is_default() {
+        out += &format!("  accuracy knobs: {}\n", scene.accuracy);
+    }
     out += &format!("  wrote {}", exr.display());
     if let Some(p) = png {
         out += &format!(", {}", p.display());

@@ -44,6 +44,8 @@ struct Map {
     distribution: Distribution2D,
     /// `cos α`, `sin α` of the rotation about +y.
     rotation: Vec2,
+    /// Sample by `distribution` (else uniformly over the sphere: the importance effect off).
+    importance: bool,
 }
 
 /// A gradient with its sampling density `∝ f(y)`, both linear on each hemisphere.
@@ -163,9 +165,18 @@ impl EnvironmentLight {
                 pixels,
                 distribution,
                 rotation,
+                importance: true,
             })),
             luminance_integral: integral as f32,
             invalid_pixels: invalid,
+        }
+    }
+
+    /// Samples a map by its luminance (`true`, the default) or uniformly over the sphere (the
+    /// environment-importance effect forced off); other environments keep their own sampling.
+    pub fn set_importance(&mut self, on: bool) {
+        if let Kind::Map(m) = &mut self.kind {
+            m.importance = on;
         }
     }
 
@@ -226,6 +237,10 @@ impl EnvironmentLight {
                 let wi = sphere_direction(y, u.y);
                 (wi, self.pdf(wi), self.radiance(wi))
             }
+            Kind::Map(m) if !m.importance => {
+                let wi = sphere_direction(1.0 - 2.0 * u.x, u.y);
+                (wi, 0.25 / PI, self.radiance(wi))
+            }
             Kind::Map(m) => {
                 let s = m.distribution.sample(u)?;
                 let theta = PI * s.uv.y;
@@ -253,6 +268,7 @@ impl EnvironmentLight {
         }
         let pdf = match &self.kind {
             Kind::Constant(_) => 0.25 / PI,
+            Kind::Map(m) if !m.importance => 0.25 / PI,
             Kind::Gradient(g) => piecewise_linear(dir.y, g.f) / (g.total * 2.0 * PI),
             Kind::Map(m) => {
                 let local = m.to_map(dir);

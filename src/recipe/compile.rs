@@ -6,9 +6,9 @@
 use super::gem::GemRecipe;
 use super::surface::{BumpDesc, FieldDesc, MapDesc, SwitchDesc};
 use super::{RecipeError, did_you_mean};
-use crate::bsdf::{Model, StackDesc};
+use crate::bsdf::StackDesc;
 use crate::sampler::hash_words;
-use crate::scene::{Effect, Effects, Scene, Surface};
+use crate::scene::{Accuracy, Effect, Effects, Scene, Surface, accuracy};
 use crate::texture::{
     Entry, FacetBump, FieldId, FieldNode, FieldTable, Map, MapNode, NodeId, Octaves, Stop, Tilt,
     Voronoi, VoronoiNode,
@@ -135,11 +135,12 @@ impl<'a> Compiler<'a> {
             names.push(name);
         }
         let stage = super::resolve::stage(r, &mut self.effects, &mut self.errors);
+        let accuracy = self.accuracy();
         let hash = recipe_hash(r);
         let ok = self.errors.is_empty() && stacks.len() == names.len();
         errors.append(&mut self.errors);
         let (map, stage) = (map?, stage?);
-        ok.then(|| Scene {
+        let mut scene = ok.then(|| Scene {
             surface: Surface {
                 names,
                 stacks,
@@ -152,8 +153,59 @@ impl<'a> Compiler<'a> {
             },
             stage,
             effects: self.effects,
+            accuracy: Accuracy::default(),
             hash,
-        })
+        })?;
+        if let Some((accuracy, by)) = accuracy
+            && let Err(e) = scene.set_accuracy(&accuracy, &by)
+        {
+            let at = r.source.find(&["accuracy", ":"]);
+            errors.push(r.source.error(at, format!("stage.render.accuracy: {e}")));
+            return None;
+        }
+        Some(scene)
+    }
+
+    /// The recipe's `stage.render.accuracy`, checked, and where it is written; errors are
+    /// recorded.
+    fn accuracy(&mut self) -> Option<(Accuracy, String)> {
+        let r = self.recipe;
+        let desc = r.content.stage.as_ref()?.render.accuracy.as_ref()?;
+        let at = r.source.find(&["accuracy", ":"]);
+        let mut acc = Accuracy {
+            model: desc.model.as_ref().map(|m| m.to_model()),
+            fresnel: desc.fresnel,
+            effects: vec![],
+        };
+        for (key, value) in [
+            ("t-term", desc.t_term),
+            ("absorption", desc.absorption),
+            ("bump", desc.bump),
+        ] {
+            if let Some(on) = value
+                && let Some(e) = accuracy::effect_named(key)
+            {
+                acc.force(e, on);
+            }
+        }
+        for (name, &on) in &desc.effects {
+            match accuracy::effect_named(name) {
+                Some(e) => acc.force(e, on),
+                None => {
+                    let names: Vec<&str> = Effect::ALL.iter().map(|e| e.name()).collect();
+                    let pos = r.source.key(name).or(at);
+                    self.errors.push(r.source.error(
+                        pos,
+                        format!(
+                            "stage.render.accuracy.effects: unknown effect \"{name}\": allowed {}",
+                            names.join(", ")
+                        ),
+                    ));
+                }
+            }
+        }
+        let e = r.source.error(at, "");
+        Some((acc, format!("render.accuracy ({}:{})", e.file, e.line)))
     }
 
     /// Effects a used material calls for.
@@ -163,16 +215,14 @@ impl<'a> Compiler<'a> {
             .library
             .position_of(name)
             .unwrap_or_else(|| "?".into());
-        for (i, c) in stack.coats.iter().enumerate() {
-            if c.thickness > 0.0 && c.absorption.max_channel() > 0.0 {
-                self.effects.turn_on(
-                    Effect::Absorption,
-                    format!("material \"{name}\" coats[{i}] ({file})"),
-                );
-            }
+        let (absorbing, t_term) = crate::scene::accuracy::stack_calls(stack);
+        if let Some(i) = absorbing {
+            self.effects.turn_on(
+                Effect::Absorption,
+                format!("material \"{name}\" coats[{i}] ({file})"),
+            );
         }
-        let t_term = stack.t_term.unwrap_or(matches!(stack.model, Model::Course));
-        if !stack.coats.is_empty() && t_term && !matches!(stack.model, Model::Reference(_)) {
+        if t_term {
             self.effects.turn_on(
                 Effect::TTerm,
                 format!("material \"{name}\" ({file}, {:?} model)", stack.model),

@@ -19,7 +19,10 @@
 //! ```
 
 use super::color::ColorDesc;
+use super::material::ModelDesc;
 use super::ranged::{finite, sizes_ok};
+use crate::bsdf::FresnelMode;
+use indexmap::IndexMap;
 use serde::{Deserialize, Deserializer, Serialize};
 
 ranged!(length_range, "length", open 0.0, 1e4);
@@ -418,6 +421,39 @@ pub struct RenderDesc {
     /// Seed of the pixel samples (not of the maps: that is the recipe's `seed`).
     #[serde(default)]
     pub seed: Option<u64>,
+    /// Accuracy knobs for every material and forced effects (DESIGN §7).
+    #[serde(default)]
+    pub accuracy: Option<AccuracyDesc>,
+}
+
+/// Accuracy knobs of a recipe (`stage.render.accuracy`): each overrides every material's own
+/// choice or forces an effect on or off ([`crate::scene::accuracy`]).
+///
+/// ```ron
+/// render: (accuracy: (model: Course, fresnel: Table, t_term: false, absorption: false,
+///                     bump: false, effects: {"depth-of-field": false})),
+/// ```
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AccuracyDesc {
+    /// Evaluation model for every material.
+    #[serde(default)]
+    pub model: Option<ModelDesc>,
+    /// Fresnel evaluation for every material.
+    #[serde(default)]
+    pub fresnel: Option<FresnelMode>,
+    /// The course's `t` term on or off for every coated material.
+    #[serde(default)]
+    pub t_term: Option<bool>,
+    /// Coat absorption on or off.
+    #[serde(default)]
+    pub absorption: Option<bool>,
+    /// Facet bump on or off.
+    #[serde(default)]
+    pub bump: Option<bool>,
+    /// Any effect by name (`lapidary info` lists them) forced on (`true`) or off.
+    #[serde(default)]
+    pub effects: IndexMap<String, bool>,
 }
 
 fn exposure_opt<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f32>, D::Error> {

@@ -16,7 +16,8 @@
 //! digits), `lapidary.seed`, `lapidary.spp` (requested), `lapidary.spp_complete`,
 //! `lapidary.sampler`, `lapidary.max_depth`, `lapidary.render_time` (seconds),
 //! `lapidary.dropped`, `lapidary.partial` (`true`/`false`), `lapidary.materials`
-//! (`index=name` pairs separated by `;`).
+//! (`index=name` pairs separated by `;`), `lapidary.accuracy` (the knobs of
+//! [`crate::scene::accuracy`] as `key=value,…`; empty when none).
 
 use super::Rendered;
 use crate::image::{Channel, ExrImage};
@@ -38,6 +39,8 @@ pub struct Metadata {
     pub max_depth: u32,
     /// Material names by index.
     pub materials: Vec<String>,
+    /// Accuracy knobs applied (`key=value,…`, empty when none).
+    pub accuracy: String,
 }
 
 impl Metadata {
@@ -52,6 +55,7 @@ impl Metadata {
             sampler: r.sampler.name().to_string(),
             max_depth: r.max_depth,
             materials: scene.surface.names.clone(),
+            accuracy: scene.accuracy.to_string(),
         }
     }
 }
@@ -107,6 +111,7 @@ pub fn exr_image(r: &Rendered, meta: &Metadata) -> ExrImage {
         ("lapidary.dropped", s.dropped.to_string()),
         ("lapidary.partial", s.partial.to_string()),
         ("lapidary.materials", materials),
+        ("lapidary.accuracy", meta.accuracy.clone()),
     ]
     .into_iter()
     .map(|(k, v)| (k.to_string(), v))

@@ -7,7 +7,7 @@ use crate::geometry::{GeometryError, Ray, Stone, StoneHit};
 use crate::image::ImageError;
 use crate::light::{Area, EnvironmentLight};
 use crate::scene::{Effect, Scene};
-use crate::texture::Map;
+use crate::texture::{Map, MapEffects};
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 use thiserror::Error;
@@ -112,10 +112,11 @@ impl World {
                 if !scene.surface.used[k] {
                     return Ok(None);
                 }
-                let stack = LayeredBsdf::new(desc).map_err(|source| WorldError::Material {
+                let mut stack = LayeredBsdf::new(desc).map_err(|source| WorldError::Material {
                     name: scene.surface.names[k].clone(),
                     source,
                 })?;
+                stack.force_absorption(scene.effects.forced(Effect::Absorption));
                 let bsdf = Bsdf::from(stack);
                 let albedo = normal_albedo(&bsdf);
                 Ok(Some((bsdf, albedo)))
@@ -139,7 +140,10 @@ impl World {
             .ground
             .map(|g| (g.height, Bsdf::Lambert(Lambert { albedo: g.albedo })));
         let areas: Vec<Area> = stage.lights.iter().map(Area::new).collect();
-        let environment = EnvironmentLight::new(&stage.environment)?;
+        let mut environment = EnvironmentLight::new(&stage.environment)?;
+        if !scene.effects.on(Effect::EnvironmentImportance) {
+            environment.set_importance(false);
+        }
 
         let (lo, hi) = stone.bounds();
         let mut lo = lo;
@@ -177,7 +181,11 @@ impl World {
             light_prob,
             materials,
             albedo,
-            map: scene.surface.map.clone(),
+            map: scene.surface.map.with_effects(MapEffects {
+                overlay: scene.effects.forced(Effect::GlitterOverlay) != Some(false),
+                blend: scene.effects.forced(Effect::StochasticSwitch) != Some(false),
+                bump: scene.effects.forced(Effect::FacetBump) != Some(false),
+            }),
             facet_bump: scene.effects.on(Effect::FacetBump),
             bounds: (centre, radius),
         })

@@ -102,11 +102,14 @@ impl fmt::Display for Effect {
 }
 
 /// The effects a scene needs, each with the first recipe element that turned it on and how many
-/// elements call for it.
+/// elements call for it; and the effects whose code is forced on or off (an accuracy knob, or a
+/// check that code for an effect the scene does not call for changes nothing).
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Effects {
     bits: u32,
     reasons: Vec<(Effect, String, usize)>,
+    /// Forced effects: the forced state and who forced it (e.g. `--bump off`).
+    forced: Vec<(Effect, bool, String)>,
 }
 
 impl Effects {
@@ -119,10 +122,49 @@ impl Effects {
         }
     }
 
-    /// Whether the scene needs `effect` (the hot-path test: one bit).
+    /// Whether `effect`'s code runs: its forced state if forced, else whether the scene calls for
+    /// it.
     #[inline]
     pub fn on(&self, effect: Effect) -> bool {
+        match self.forced(effect) {
+            Some(on) => on,
+            None => self.called(effect),
+        }
+    }
+
+    /// Whether something in the scene calls for `effect` (forcing aside).
+    #[inline]
+    pub fn called(&self, effect: Effect) -> bool {
         self.bits & effect.bit() != 0
+    }
+
+    /// Forces `effect`'s code on or off; `by` names who did (a flag or a recipe field).
+    pub fn force(&mut self, effect: Effect, on: bool, by: impl Into<String>) {
+        self.forced.retain(|(e, _, _)| *e != effect);
+        self.forced.push((effect, on, by.into()));
+    }
+
+    /// The forced state of `effect`, if it is forced.
+    pub fn forced(&self, effect: Effect) -> Option<bool> {
+        self.forced
+            .iter()
+            .find(|(e, _, _)| *e == effect)
+            .map(|(_, on, _)| *on)
+    }
+
+    /// Who forced `effect`, if anyone.
+    pub fn forced_by(&self, effect: Effect) -> Option<&str> {
+        self.forced
+            .iter()
+            .find(|(e, _, _)| *e == effect)
+            .map(|(_, _, by)| by.as_str())
+    }
+
+    /// Forgets that anything calls for `effect` (used when a knob rewrites the materials and
+    /// their effects are recounted).
+    pub(crate) fn clear(&mut self, effect: Effect) {
+        self.bits &= !effect.bit();
+        self.reasons.retain(|(e, _, _)| *e != effect);
     }
 
     /// The first element that turned `effect` on and the number of elements that call for it.
@@ -133,7 +175,7 @@ impl Effects {
             .map(|(_, s, n)| (s.as_str(), *n))
     }
 
-    /// The effects that are on, in [`Effect::ALL`] order.
+    /// The effects whose code runs ([`on`](Self::on)), in [`Effect::ALL`] order.
     pub fn iter(&self) -> impl Iterator<Item = Effect> + '_ {
         Effect::ALL.into_iter().filter(|e| self.on(*e))
     }

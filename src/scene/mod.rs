@@ -5,10 +5,12 @@
 //! (shape, placement, ground, environment, lights, camera, render settings) and the [`Effects`] set:
 //! which optional parts of the simulation the scene calls for, and why.
 
+pub mod accuracy;
 pub mod effects;
 pub mod stage;
 pub mod surface;
 
+pub use accuracy::{Accuracy, KnobError, Knobs};
 pub use effects::{Effect, Effects};
 pub use stage::Stage;
 pub use surface::Surface;
@@ -20,8 +22,10 @@ pub struct Scene {
     pub surface: Surface,
     /// Shape, lights, camera, render settings.
     pub stage: Stage,
-    /// The effects the scene calls for.
+    /// The effects the scene calls for, and those forced on or off.
     pub effects: Effects,
+    /// The accuracy knobs applied so far (recipe, then command line).
+    pub accuracy: Accuracy,
     /// Hash of the recipe's text and included files (for render metadata).
     pub hash: u64,
 }

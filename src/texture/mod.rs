@@ -4,6 +4,7 @@
 //! - [`perlin`](mod@perlin): hashed-lattice gradient noise, fBm and turbulence.
 //! - [`field`]: scalar fields (Perlin, turbulence, marble, sums, products, remaps) in a flat table.
 //! - [`bump`]: the crystal-facet bump map (tilt distributions, the rule for facets seen from behind).
+//! - [`simplify`]: the same tree with the glitter overlay, switch bands or facet bump left out.
 //! - [`map`]: the runtime map tree — Voronoi surface and glitter maps, overlays, switches, material
 //!   leaves — and its allocation-free lookup.
 //!
@@ -14,10 +15,12 @@ pub mod bump;
 pub mod field;
 pub mod map;
 pub mod perlin;
+pub mod simplify;
 pub mod voronoi;
 
 pub use bump::{FacetBump, Tilt};
 pub use field::{FieldId, FieldNode, FieldTable};
 pub use map::{CellTrail, Entry, Map, MapError, MapHit, MapNode, NodeId, Stop, VoronoiNode};
 pub use perlin::{Octaves, perlin};
+pub use simplify::MapEffects;
 pub use voronoi::{Voronoi, VoronoiNearest, VoronoiSample};

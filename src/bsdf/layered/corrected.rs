@@ -62,7 +62,7 @@ pub fn eval(stack: &LayeredBsdf, l: usize, wo: Vec3, wi: Vec3) -> Spectrum {
             } else {
                 to
             };
-            f += rest * absorption(lv.od, wo_in.z, wi_in.z) * (ti * exit / (lv.eta * lv.eta));
+            f += rest * lv.absorb(wo_in.z, wi_in.z) * (ti * exit / (lv.eta * lv.eta));
         }
     }
     // Symmetric multiple-reflection lobe M · q(wo) q(wi) / ∫q cos (module docs); q(wi) = 0

@@ -6,7 +6,7 @@
 //! the albedo tests pin that departure. Sampling and pdf are the shared mixture in
 //! [`super::corrected`] without the multiple-reflection lobe.
 
-use super::{LayeredBsdf, absorption};
+use super::LayeredBsdf;
 use crate::bsdf::{Bxdf, microfacet::v_cavity_g, refract_macro};
 use crate::color::Spectrum;
 use glam::Vec3;
@@ -40,6 +40,6 @@ pub fn eval(stack: &LayeredBsdf, l: usize, wo: Vec3, wi: Vec3) -> Spectrum {
     } else {
         1.0
     };
-    f += rest * absorption(lv.od, wo_in.z, wi_in.z) * (t12 * t);
+    f += rest * lv.absorb(wo_in.z, wi_in.z) * (t12 * t);
     f
 }

@@ -185,6 +185,9 @@ pub(crate) struct Level {
     pub index_matched: bool,
     /// Optical depth `α·d` at normal incidence, per channel.
     pub od: Spectrum,
+    /// Whether the absorption code runs for this coat: when `od` is non-zero, or when the
+    /// absorption effect is forced on (then a clear coat's factor is exactly 1).
+    pub absorbing: bool,
     /// Directional albedo of `top`, over `cos θo` outside.
     pub e_top: Table,
     /// `A(μ') = ∫ a(w',wi') f_rest(w',wi') cos θi' dωi'` over the inner `cos θ'`.
@@ -203,21 +206,42 @@ impl Level {
     pub fn t(&self, cos: f32) -> f32 {
         (1.0 - self.e_top.at(cos)[0]).clamp(0.0, 1.0)
     }
+
+    /// [`absorption`] in this coat, or 1 when its absorption code is off.
+    #[inline]
+    pub fn absorb(&self, cos_a: f32, cos_b: f32) -> Spectrum {
+        if self.absorbing {
+            absorption(self.od, cos_a, cos_b)
+        } else {
+            Spectrum::ONE
+        }
+    }
+
+    /// [`transmittance`] of one leg in this coat, or 1 when its absorption code is off.
+    #[inline]
+    pub fn transmit(&self, cos: f32) -> Spectrum {
+        if self.absorbing {
+            transmittance(self.od, cos)
+        } else {
+            Spectrum::ONE
+        }
+    }
 }
 
 /// Absorption along the two inner legs, `exp(−α d (1/cos θi' + 1/cos θo'))` (course eq. 3.2); 0
-/// (never NaN) when the optical depth is huge or a leg is grazing.
+/// (never NaN) when the optical depth is huge or a leg is grazing, and exactly 1 for `α d = 0`
+/// (the path length is at most `2·10¹²`, so `0 · path = 0`).
 #[inline]
 pub fn absorption(od: Spectrum, cos_a: f32, cos_b: f32) -> Spectrum {
     let path = 1.0 / cos_a.abs().max(1e-12) + 1.0 / cos_b.abs().max(1e-12);
-    od.map(|o| if o == 0.0 { 1.0 } else { (-o * path).exp() })
+    od.map(|o| (-o * path).exp())
 }
 
-/// Transmittance of one inner leg, `exp(−α d / |cos θ|)`.
+/// Transmittance of one inner leg, `exp(−α d / |cos θ|)`; exactly 1 for `α d = 0`.
 #[inline]
 pub fn transmittance(od: Spectrum, cos: f32) -> Spectrum {
     let path = 1.0 / cos.abs().max(1e-12);
-    od.map(|o| if o == 0.0 { 1.0 } else { (-o * path).exp() })
+    od.map(|o| (-o * path).exp())
 }
 
 /// A compiled layer stack: the material interface of lapidary.
@@ -257,6 +281,7 @@ impl LayeredBsdf {
                 interface: RoughDielectric::new(dist, eta),
                 index_matched: (eta - 1.0).abs() < 1e-6,
                 od: c.absorption * c.thickness,
+                absorbing: (c.absorption * c.thickness).max_channel() > 0.0,
                 e_top: Table::zero(),
                 albedo_rest: Table::zero(),
                 trapped: Table::zero(),
@@ -347,6 +372,15 @@ impl LayeredBsdf {
             if self.t_term() { "on" } else { "off" },
             if self.compensation { "on" } else { "off" }
         )
+    }
+
+    /// Forces the absorption code of every coat on (`Some(true)`: clear coats multiply by exactly
+    /// 1), off (`Some(false)`: for stacks whose absorption was cleared before building, see
+    /// [`crate::scene::Accuracy`]) or leaves it to each coat (`None`: on where `α d > 0`).
+    pub fn force_absorption(&mut self, forced: Option<bool>) {
+        for lv in self.levels.iter_mut() {
+            lv.absorbing = forced.unwrap_or(lv.od.max_channel() > 0.0);
+        }
     }
 
     /// The same compiled stack evaluated by another model (tables are shared by all models).

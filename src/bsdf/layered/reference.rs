@@ -21,7 +21,7 @@
 //!   walk can exit. `sample` reports that pdf and `f = weight · pdf / cos θi`, so
 //!   `weight = f cos/pdf` holds; chi-square tests do not apply to this model.
 
-use super::{LayeredBsdf, ReferenceParams, corrected, transmittance};
+use super::{LayeredBsdf, ReferenceParams, corrected};
 use crate::bsdf::dielectric::Lobes;
 use crate::bsdf::{BsdfSample, Bxdf, Lobe, LobeKind, TransportMode, power_heuristic};
 use crate::color::Spectrum;
@@ -106,7 +106,7 @@ fn eval_at(
     }
     if lv.index_matched {
         // An invisible interface: straight through, absorption both ways.
-        let a = transmittance(lv.od, wo.z) * transmittance(lv.od, wi.z);
+        let a = lv.transmit(wo.z) * lv.transmit(wi.z);
         return a * eval_at(stack, p, l + 1, wo, wi, rng);
     }
     let iface = &lv.interface;
@@ -144,7 +144,7 @@ fn eval_at(
                 }
                 beta = beta / (1.0 - q);
             }
-            beta *= transmittance(lv.od, w.z);
+            beta *= lv.transmit(w.z);
             // Strategy A: connect the bottom to the pre-sampled transmitted direction of wi.
             let up_light = -wis.wi;
             let fb = eval_at(stack, p, l + 1, -w, up_light, rng);
@@ -153,7 +153,7 @@ fn eval_at(
                 acc += beta
                     * fb
                     * (up_light.z.abs() * wt / wis.pdf)
-                    * transmittance(lv.od, up_light.z)
+                    * lv.transmit(up_light.z)
                     * exit_a;
             }
             // Continue the walk at the bottom.
@@ -167,9 +167,9 @@ fn eval_at(
             if fe > 0.0 {
                 let pa = iface.pdf(wi, -w, Lobes::Transmission);
                 let wt = power_heuristic(pdf_b, pa);
-                acc += beta * transmittance(lv.od, w.z) * (fe * wt);
+                acc += beta * lv.transmit(w.z) * (fe * wt);
             }
-            beta *= transmittance(lv.od, w.z);
+            beta *= lv.transmit(w.z);
             // Internal reflection back down at the interface.
             let Some(rs) = iface.sample(
                 -w,
@@ -226,10 +226,7 @@ fn walk_at(
     };
     if lv.index_matched {
         let (wi, weight) = walk_at(stack, p, l + 1, wo, first, rng)?;
-        return Some((
-            wi,
-            weight * transmittance(lv.od, wo.z) * transmittance(lv.od, wi.z),
-        ));
+        return Some((wi, weight * lv.transmit(wo.z) * lv.transmit(wi.z)));
     }
     let iface = &lv.interface;
     let (uc, u) = first.unwrap_or_else(|| (rng.uniform(), rng.uniform2()));
@@ -248,9 +245,9 @@ fn walk_at(
             }
             beta = beta / (1.0 - q);
         }
-        beta *= transmittance(lv.od, w.z);
+        beta *= lv.transmit(w.z);
         let (wb, wtb, _) = sample_bottom(stack, p, l + 1, -w, rng)?;
-        beta *= wtb * transmittance(lv.od, wb.z);
+        beta *= wtb * lv.transmit(wb.z);
         let s = iface.sample(
             -wb,
             rng.uniform(),

@@ -1,0 +1,119 @@
+//! The accuracy knobs on the command line (shared by `render` and `tradeoff`): `--model`,
+//! `--fresnel`, `--t-term`, `--absorption`, `--bump` and `--effect NAME=on|off`. They override the
+//! recipe's `render.accuracy` and every material's own choice ([`crate::scene::accuracy`]).
+
+use crate::bsdf::{FresnelMode, Model};
+use crate::scene::accuracy::{effect_named, parse_fresnel, parse_model};
+use crate::scene::{Accuracy, Effect, KnobError, Scene};
+use clap::Args;
+
+/// Accuracy knobs.
+#[derive(Debug, Clone, Default, Args)]
+pub struct KnobArgs {
+    /// Evaluation model of every material: course, corrected or reference.
+    #[arg(long, value_parser = model_arg)]
+    pub model: Option<Model>,
+    /// Fresnel evaluation of every material: exact, schlick, lazanyi or table.
+    #[arg(long, value_parser = fresnel_arg)]
+    pub fresnel: Option<FresnelMode>,
+    /// The course's `t` term for every coated material: on or off.
+    #[arg(long, value_parser = switch_arg)]
+    pub t_term: Option<bool>,
+    /// Coat absorption: on or off.
+    #[arg(long, value_parser = switch_arg)]
+    pub absorption: Option<bool>,
+    /// Crystal-facet bump: on or off.
+    #[arg(long, value_parser = switch_arg)]
+    pub bump: Option<bool>,
+    /// Force any effect's code on or off, e.g. `--effect depth-of-field=off` (repeatable;
+    /// `lapidary info` lists the effects).
+    #[arg(long = "effect", value_parser = effect_arg)]
+    pub effects: Vec<(Effect, bool)>,
+}
+
+impl KnobArgs {
+    /// The knobs given, as an [`Accuracy`].
+    pub fn accuracy(&self) -> Accuracy {
+        let mut acc = Accuracy {
+            model: self.model,
+            fresnel: self.fresnel,
+            effects: vec![],
+        };
+        for (e, on) in [
+            (Effect::TTerm, self.t_term),
+            (Effect::Absorption, self.absorption),
+            (Effect::FacetBump, self.bump),
+        ] {
+            if let Some(on) = on {
+                acc.force(e, on);
+            }
+        }
+        for &(e, on) in &self.effects {
+            acc.force(e, on);
+        }
+        acc
+    }
+
+    /// Applies the knobs to `scene` (credited to the command line).
+    pub fn apply(&self, scene: &mut Scene) -> Result<(), KnobError> {
+        scene.set_accuracy(&self.accuracy(), "command line")
+    }
+}
+
+fn model_arg(s: &str) -> Result<Model, String> {
+    parse_model(s).map_err(|e| e.0)
+}
+
+fn fresnel_arg(s: &str) -> Result<FresnelMode, String> {
+    parse_fresnel(s).map_err(|e| e.0)
+}
+
+fn switch_arg(s: &str) -> Result<bool, String> {
+    match s.to_ascii_lowercase().as_str() {
+        "on" | "true" => Ok(true),
+        "off" | "false" => Ok(false),
+        _ => Err(format!("`{s}` is not one of: on, off")),
+    }
+}
+
+fn effect_arg(s: &str) -> Result<(Effect, bool), String> {
+    let names = || {
+        Effect::ALL
+            .iter()
+            .map(|e| e.name())
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let (name, value) = s
+        .split_once('=')
+        .ok_or_else(|| format!("`{s}` is not NAME=on|off (effects: {})", names()))?;
+    let e = effect_named(name.trim())
+        .ok_or_else(|| format!("unknown effect `{name}`: allowed {}", names()))?;
+    Ok((e, switch_arg(value.trim())?))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn arguments_become_knobs() {
+        let k = KnobArgs {
+            model: Some(Model::Course),
+            bump: Some(false),
+            effects: vec![effect_arg("depth-of-field=on").unwrap()],
+            ..KnobArgs::default()
+        };
+        assert_eq!(
+            k.accuracy().to_string(),
+            "model=course,bump=off,depth-of-field=on"
+        );
+        assert!(effect_arg("sparkle=on").unwrap_err().contains("facet-bump"));
+        assert!(
+            effect_arg("absorption")
+                .unwrap_err()
+                .contains("NAME=on|off")
+        );
+        assert!(switch_arg("maybe").unwrap_err().contains("on, off"));
+    }
+}

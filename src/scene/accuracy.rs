@@ -1,0 +1,417 @@
+//! Accuracy knobs (DESIGN §7): every approximation and optional effect of a render, settable from
+//! the command line (`lapidary render --model course --bump off …`), from a recipe
+//! (`render: (accuracy: (…))`) and by `lapidary tradeoff --setting …`.
+//!
+//! A knob either rewrites what the scene asks for (the evaluation model and Fresnel mode of every
+//! material) or **forces an effect's code** on or off ([`Effects::force`]):
+//!
+//! | knob | forced off | forced on |
+//! |---|---|---|
+//! | `t-term` | every coated material without the course's `t` term | every coated Course/Corrected material with it |
+//! | `absorption` | coats are clear (`α = 0`) | the absorption code runs for clear coats too (factor exactly 1) |
+//! | `bump` (`facet-bump`) | facet normals are ignored | facet frames are used wherever a map gives one |
+//! | `glitter-overlay` | an `Overlay` shows only its `under` map | (no code to force) |
+//! | `stochastic-switch` | switches are hard (`blend` ignored) | (no code to force) |
+//! | `depth-of-field` | a pinhole camera | the thin-lens code runs even at aperture 0 |
+//! | `environment-importance` | an environment map is sampled uniformly | (no code to force) |
+//!
+//! Render-level knobs (spp, sampler, maximum depth) live in the render settings; [`Knobs`] bundles
+//! them with an [`Accuracy`] for `tradeoff` settings written as `key=value,key=value`.
+
+use super::{Effect, Scene};
+use crate::bsdf::{FresnelMode, Model, ReferenceParams, StackDesc};
+use crate::sampler::SamplerKind;
+use std::fmt;
+
+/// Material-level knobs and forced effects. The default changes nothing.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Accuracy {
+    /// Evaluation model for every material (`None`: each material's own).
+    pub model: Option<Model>,
+    /// Fresnel evaluation for every material (`None`: each material's own).
+    pub fresnel: Option<FresnelMode>,
+    /// Effects forced on (`true`) or off, in the order they were set.
+    pub effects: Vec<(Effect, bool)>,
+}
+
+/// An accuracy knob that cannot be set.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{0}")]
+pub struct KnobError(pub String);
+
+impl Accuracy {
+    /// Forces `effect` on or off (replacing an earlier setting of it).
+    pub fn force(&mut self, effect: Effect, on: bool) {
+        self.effects.retain(|(e, _)| *e != effect);
+        self.effects.push((effect, on));
+    }
+
+    /// The forced state of `effect`, if set.
+    pub fn forced(&self, effect: Effect) -> Option<bool> {
+        self.effects
+            .iter()
+            .find(|(e, _)| *e == effect)
+            .map(|(_, on)| *on)
+    }
+
+    /// Whether no knob is set.
+    pub fn is_default(&self) -> bool {
+        *self == Accuracy::default()
+    }
+
+    /// Sets the knob `key` (`model`, `fresnel`, `t-term`, `absorption`, `bump`, or an effect name)
+    /// from its written `value`; the error names the allowed values.
+    pub fn set(&mut self, key: &str, value: &str) -> Result<(), KnobError> {
+        match key {
+            "model" => self.model = Some(parse_model(value)?),
+            "fresnel" => self.fresnel = Some(parse_fresnel(value)?),
+            _ => {
+                let effect = effect_named(key).ok_or_else(|| {
+                    KnobError(format!(
+                        "unknown knob `{key}`: allowed {}",
+                        KNOB_KEYS.join(", ")
+                    ))
+                })?;
+                self.force(effect, parse_switch(key, value)?);
+            }
+        }
+        Ok(())
+    }
+
+    /// Applies the knobs to one material description.
+    pub fn apply_to(&self, stack: &mut StackDesc) {
+        if let Some(m) = self.model {
+            stack.model = m;
+        }
+        if let Some(f) = self.fresnel {
+            stack.fresnel = f;
+        }
+        if let Some(t) = self.forced(Effect::TTerm) {
+            stack.t_term = Some(t);
+        }
+        if self.forced(Effect::Absorption) == Some(false) {
+            for c in &mut stack.coats {
+                c.absorption = crate::color::Spectrum::ZERO;
+            }
+        }
+    }
+}
+
+/// Every knob key [`Knobs::set`] accepts (the effect names of [`Effect::name`] work too).
+pub const KNOB_KEYS: [&str; 11] = [
+    "model",
+    "fresnel",
+    "t-term",
+    "absorption",
+    "bump",
+    "glitter-overlay",
+    "stochastic-switch",
+    "depth-of-field",
+    "environment-importance",
+    "sampler",
+    "max-depth",
+];
+
+/// The effect a knob key names (`bump` is short for `facet-bump`).
+pub fn effect_named(key: &str) -> Option<Effect> {
+    match key {
+        "bump" => Some(Effect::FacetBump),
+        "t_term" => Some(Effect::TTerm),
+        _ => Effect::ALL.into_iter().find(|e| e.name() == key),
+    }
+}
+
+/// `course`, `corrected` or `reference` (4 walks per evaluation, depth 256).
+pub fn parse_model(value: &str) -> Result<Model, KnobError> {
+    match value.to_ascii_lowercase().as_str() {
+        "course" => Ok(Model::Course),
+        "corrected" => Ok(Model::Corrected),
+        "reference" => Ok(Model::Reference(ReferenceParams::default())),
+        _ => Err(KnobError(format!(
+            "model `{value}` is not one of: course, corrected, reference"
+        ))),
+    }
+}
+
+/// `exact`, `schlick`, `lazanyi` or `table`.
+pub fn parse_fresnel(value: &str) -> Result<FresnelMode, KnobError> {
+    match value.to_ascii_lowercase().as_str() {
+        "exact" => Ok(FresnelMode::Exact),
+        "schlick" => Ok(FresnelMode::Schlick),
+        "lazanyi" => Ok(FresnelMode::Lazanyi),
+        "table" => Ok(FresnelMode::Table),
+        _ => Err(KnobError(format!(
+            "fresnel `{value}` is not one of: exact, schlick, lazanyi, table"
+        ))),
+    }
+}
+
+fn parse_switch(key: &str, value: &str) -> Result<bool, KnobError> {
+    match value.to_ascii_lowercase().as_str() {
+        "on" | "true" | "yes" => Ok(true),
+        "off" | "false" | "no" => Ok(false),
+        _ => Err(KnobError(format!("{key} `{value}` is not one of: on, off"))),
+    }
+}
+
+/// The label of a model, as the knob parser spells it.
+pub fn model_label(m: Model) -> &'static str {
+    match m {
+        Model::Course => "course",
+        Model::Corrected => "corrected",
+        Model::Reference(_) => "reference",
+    }
+}
+
+impl fmt::Display for Accuracy {
+    /// `key=value` pairs joined by commas, in the form [`Accuracy::set`] reads.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let mut parts = vec![];
+        if let Some(m) = self.model {
+            parts.push(format!("model={}", model_label(m)));
+        }
+        if let Some(fr) = self.fresnel {
+            parts.push(format!(
+                "fresnel={}",
+                format!("{fr:?}").to_ascii_lowercase()
+            ));
+        }
+        for (e, on) in &self.effects {
+            let name = if *e == Effect::FacetBump {
+                "bump"
+            } else {
+                e.name()
+            };
+            parts.push(format!("{name}={}", if *on { "on" } else { "off" }));
+        }
+        f.write_str(&parts.join(","))
+    }
+}
+
+/// An [`Accuracy`] plus the render-level knobs: one setting of a `tradeoff` study.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Knobs {
+    /// Material-level knobs and forced effects.
+    pub accuracy: Accuracy,
+    /// Sampler (`None`: the recipe's).
+    pub sampler: Option<SamplerKind>,
+    /// Longest path in bounces (`None`: the recipe's).
+    pub max_depth: Option<u32>,
+}
+
+impl Knobs {
+    /// Sets one knob (any key of [`KNOB_KEYS`]).
+    pub fn set(&mut self, key: &str, value: &str) -> Result<(), KnobError> {
+        match key {
+            "sampler" => {
+                self.sampler = Some(match value.to_ascii_lowercase().as_str() {
+                    "sobol" => SamplerKind::Sobol,
+                    "independent" => SamplerKind::Independent,
+                    _ => {
+                        return Err(KnobError(format!(
+                            "sampler `{value}` is not one of: sobol, independent"
+                        )));
+                    }
+                })
+            }
+            "max-depth" | "max_depth" => {
+                let d: u32 = value
+                    .parse()
+                    .ok()
+                    .filter(|d| (1..=1024).contains(d))
+                    .ok_or_else(|| {
+                        KnobError(format!(
+                            "max-depth `{value}` is out of range: allowed 1 ..= 1024"
+                        ))
+                    })?;
+                self.max_depth = Some(d);
+            }
+            _ => self.accuracy.set(key, value)?,
+        }
+        Ok(())
+    }
+
+    /// Applies the render-level knobs to `scene`'s settings and the rest with
+    /// [`Scene::set_accuracy`].
+    pub fn apply(&self, scene: &mut Scene, by: &str) -> Result<(), KnobError> {
+        if let Some(s) = self.sampler {
+            scene.stage.render.sampler = s;
+        }
+        if let Some(d) = self.max_depth {
+            scene.stage.render.max_depth = d;
+        }
+        scene.set_accuracy(&self.accuracy, by)
+    }
+}
+
+impl std::str::FromStr for Knobs {
+    type Err = KnobError;
+
+    /// `key=value,key=value` (an empty string or `baseline` sets nothing).
+    fn from_str(s: &str) -> Result<Knobs, KnobError> {
+        let mut k = Knobs::default();
+        for part in s.split(',').map(str::trim).filter(|p| !p.is_empty()) {
+            if part == "baseline" {
+                continue;
+            }
+            let (key, value) = part.split_once('=').ok_or_else(|| {
+                KnobError(format!(
+                    "`{part}` is not `key=value` (keys: {})",
+                    KNOB_KEYS.join(", ")
+                ))
+            })?;
+            k.set(key.trim(), value.trim())?;
+        }
+        Ok(k)
+    }
+}
+
+impl fmt::Display for Knobs {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let mut parts = vec![];
+        let acc = self.accuracy.to_string();
+        if !acc.is_empty() {
+            parts.push(acc);
+        }
+        if let Some(s) = self.sampler {
+            parts.push(format!("sampler={}", format!("{s:?}").to_ascii_lowercase()));
+        }
+        if let Some(d) = self.max_depth {
+            parts.push(format!("max-depth={d}"));
+        }
+        if parts.is_empty() {
+            f.write_str("baseline")
+        } else {
+            f.write_str(&parts.join(","))
+        }
+    }
+}
+
+/// Which effects a material calls for: the first absorbing coat, and whether the `t` term applies.
+pub(crate) fn stack_calls(stack: &StackDesc) -> (Option<usize>, bool) {
+    let absorbing = stack
+        .coats
+        .iter()
+        .position(|c| c.thickness > 0.0 && c.absorption.max_channel() > 0.0);
+    let t_term = !stack.coats.is_empty()
+        && stack.t_term.unwrap_or(matches!(stack.model, Model::Course))
+        && !matches!(stack.model, Model::Reference(_));
+    (absorbing, t_term)
+}
+
+impl Scene {
+    /// Applies accuracy knobs: rewrites every material's model and Fresnel mode, recounts which
+    /// materials call for absorption and the `t` term, and forces the chosen effects. `by` names
+    /// where the knobs came from (`command line`, `render.accuracy`), for `lapidary info`.
+    ///
+    /// Fails (changing nothing) when an effect this version cannot simulate is forced on.
+    pub fn set_accuracy(&mut self, acc: &Accuracy, by: &str) -> Result<(), KnobError> {
+        if let Some((e, _)) = acc.effects.iter().find(|(e, on)| *on && !e.implemented()) {
+            return Err(KnobError(format!(
+                "{e} cannot be forced on: this version does not simulate it"
+            )));
+        }
+        if acc.is_default() {
+            return Ok(());
+        }
+        for stack in &mut self.surface.stacks {
+            acc.apply_to(stack);
+        }
+        self.effects.clear(Effect::Absorption);
+        self.effects.clear(Effect::TTerm);
+        for (k, stack) in self.surface.stacks.iter().enumerate() {
+            if !self.surface.used[k] {
+                continue;
+            }
+            let name = &self.surface.names[k];
+            let (absorbing, t_term) = stack_calls(stack);
+            if let Some(i) = absorbing {
+                self.effects.turn_on(
+                    Effect::Absorption,
+                    format!("material \"{name}\" coats[{i}]"),
+                );
+            }
+            if t_term {
+                self.effects.turn_on(
+                    Effect::TTerm,
+                    format!(
+                        "material \"{name}\" ({:?} model, knobs from {by})",
+                        stack.model
+                    ),
+                );
+            }
+        }
+        for &(e, on) in &acc.effects {
+            self.effects.force(e, on, by);
+            self.accuracy.force(e, on);
+        }
+        self.accuracy.model = acc.model.or(self.accuracy.model);
+        self.accuracy.fresnel = acc.fresnel.or(self.accuracy.fresnel);
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_and_prints_settings() {
+        let k: Knobs =
+            "model=course, fresnel=table,bump=off,t-term=on,sampler=independent,max-depth=4"
+                .parse()
+                .unwrap();
+        assert_eq!(k.accuracy.model, Some(Model::Course));
+        assert_eq!(k.accuracy.fresnel, Some(FresnelMode::Table));
+        assert_eq!(k.accuracy.forced(Effect::FacetBump), Some(false));
+        assert_eq!(k.accuracy.forced(Effect::TTerm), Some(true));
+        assert_eq!(k.sampler, Some(SamplerKind::Independent));
+        assert_eq!(k.max_depth, Some(4));
+        let again: Knobs = k.to_string().parse().unwrap();
+        assert_eq!(again, k);
+        assert_eq!("baseline".parse::<Knobs>().unwrap().to_string(), "baseline");
+    }
+
+    #[test]
+    fn bad_knobs_name_what_is_allowed() {
+        let e = "model=fast".parse::<Knobs>().unwrap_err().0;
+        assert!(e.contains("course, corrected, reference"), "{e}");
+        let e = "bump=maybe".parse::<Knobs>().unwrap_err().0;
+        assert!(e.contains("on, off"), "{e}");
+        let e = "max-depth=0".parse::<Knobs>().unwrap_err().0;
+        assert!(e.contains("1 ..= 1024"), "{e}");
+        let e = "colour=red".parse::<Knobs>().unwrap_err().0;
+        assert!(e.contains("unknown knob") && e.contains("fresnel"), "{e}");
+        let e = "bump".parse::<Knobs>().unwrap_err().0;
+        assert!(e.contains("key=value"), "{e}");
+    }
+
+    #[test]
+    fn apply_rewrites_materials() {
+        use crate::bsdf::{Base, Coat};
+        use crate::color::Spectrum;
+        let coat = Coat {
+            ior: 1.5,
+            roughness: 10.0,
+            absorption: Spectrum::splat(0.5),
+            thickness: 1.0,
+        };
+        let mut s = StackDesc::new(
+            vec![coat],
+            Base::Lambert {
+                albedo: Spectrum::splat(0.5),
+            },
+        );
+        assert_eq!(stack_calls(&s), (Some(0), false));
+        let k: Knobs = "model=course,absorption=off,fresnel=schlick"
+            .parse()
+            .unwrap();
+        k.accuracy.apply_to(&mut s);
+        assert_eq!((s.model, s.fresnel), (Model::Course, FresnelMode::Schlick));
+        assert_eq!(s.coats[0].absorption, Spectrum::ZERO);
+        assert_eq!(stack_calls(&s), (None, true));
+        let k: Knobs = "t-term=off".parse().unwrap();
+        k.accuracy.apply_to(&mut s);
+        assert_eq!(stack_calls(&s), (None, false));
+    }
+}
