@@ -212,3 +212,56 @@ fn info_prints_materials_map_statistics_stage_and_effects() {
     assert!(err.contains(":1:26: unknown material \"x\""), "{err}");
     let _ = std::fs::remove_file(&bad);
 }
+
+#[test]
+fn render_accuracy_knobs_rewrite_materials_and_force_effects() {
+    use lapidary::bsdf::{FresnelMode, Model};
+    const M: &str = r#"materials: {
+        "tinted": (coats: [(ior: 1.5, roughness: 2.0, thickness: 1.0, tint: Gray(0.5))],
+                   base: Lambert(albedo: Gray(0.5))),
+    },
+    surface: Voronoi(scale: 0.1, entries: [(1.0, Material("tinted"))], bump: Cone(half_angle: 20.0)),"#;
+    let plain = compile(&format!("({M})"));
+    assert!(plain.effects.on(Effect::Absorption) && plain.effects.on(Effect::FacetBump));
+    assert!(plain.accuracy.is_default());
+
+    let s = compile(&format!(
+        "({M} stage: (render: (accuracy: (model: Course, fresnel: Table, absorption: false, \
+         bump: false, effects: {{\"depth-of-field\": true}}))))"
+    ));
+    let stack = &s.surface.stacks[0];
+    assert_eq!((stack.model, stack.fresnel), (Model::Course, FresnelMode::Table));
+    assert_eq!(stack.coats[0].absorption.max_channel(), 0.0);
+    // Absorption is gone from what the scene calls for; the Course model turned the t term on.
+    assert!(!s.effects.called(Effect::Absorption) && !s.effects.on(Effect::Absorption));
+    assert!(s.effects.on(Effect::TTerm));
+    // The bump is still called for by the map, but forced off; depth of field forced on.
+    assert!(s.effects.called(Effect::FacetBump) && !s.effects.on(Effect::FacetBump));
+    assert!(!s.effects.called(Effect::DepthOfField) && s.effects.on(Effect::DepthOfField));
+    let by = s.effects.forced_by(Effect::FacetBump).unwrap();
+    assert!(by.contains("render.accuracy") && by.contains("t.ron:"), "{by}");
+    assert_eq!(
+        s.accuracy.to_string(),
+        "model=course,fresnel=table,absorption=off,bump=off,depth-of-field=on"
+    );
+
+    // Bad knobs: an unknown effect names the allowed ones at its line; an unknown field is a
+    // parse error with its position; an effect this version cannot simulate cannot be forced on.
+    let err = |text: String| match GemRecipe::parse("t.ron", &text).and_then(|r| r.compile()) {
+        Ok(_) => panic!("accepted: {text}"),
+        Err(e) => e.to_string(),
+    };
+    let e = err(format!(
+        "({M} stage: (render: (accuracy: (effects: {{\"sparkle\": true}}))))"
+    ));
+    assert!(
+        e.contains("t.ron:") && e.contains("unknown effect \"sparkle\"") && e.contains("facet-bump"),
+        "{e}"
+    );
+    let e = err(format!("({M} stage: (render: (accuracy: (speed: 2))))"));
+    assert!(e.contains("t.ron:") && e.contains("speed"), "{e}");
+    let e = err(format!(
+        "({M} stage: (render: (accuracy: (effects: {{\"spectral\": true}}))))"
+    ));
+    assert!(e.contains("does not simulate"), "{e}");
+}

@@ -10,6 +10,8 @@ pub mod map;
 pub mod plot;
 pub mod regress;
 pub mod render;
+pub mod tradeoff;
+pub mod tradeoff_plot;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -50,6 +52,10 @@ pub enum Command {
     /// Run a folder of recipes against the reference EXRs beside them (NAME.ron + NAME.exr) and
     /// print a table; --update makes the references. Exits as compare does.
     Regress(regress::RegressArgs),
+    /// Measure what accuracy costs in time: render a converged reference (cached), then each knob
+    /// setting for a time budget; print time and error (relMSE, FLIP, energy) at equal spp and
+    /// equal time, and write a CSV and a log-log plot of error against time.
+    Tradeoff(tradeoff::TradeoffArgs),
 }
 
 /// Parses the process arguments and runs; errors are printed as `error: …` and exit with 1.
@@ -59,6 +65,7 @@ pub fn run() -> ExitCode {
         Command::Brdf(args) => brdf::run(&args),
         Command::Map(args) => map::run(&args),
         Command::Info(args) => info::run(&args),
+        Command::Tradeoff(args) => tradeoff::run(&args),
         Command::Render(args) => match render::run(&args) {
             Ok(false) => Ok(()),
             Ok(true) => return ExitCode::from(130),

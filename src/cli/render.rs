@@ -233,6 +233,7 @@ pub fn run(args: &RenderArgs) -> Result<bool> {
             .map(|s| Instant::now() + Duration::from_secs_f64(s)),
         cancel: Some(cancel),
         progress: Some(&progress),
+        on_pass: None,
     };
     let dof = scene.effects.on(Effect::DepthOfField);
     let rendered = render(&world, &scene.stage.camera, dof, &r, &control);

@@ -15,6 +15,7 @@ pub mod film;
 pub mod filter;
 pub mod integrator;
 pub mod output;
+pub mod study;
 pub mod world;
 
 pub use camera::CameraRays;
@@ -47,6 +48,10 @@ pub struct Control<'a> {
     pub cancel: Option<&'a AtomicBool>,
     /// Called after each tile with the number of pixel samples it added.
     pub progress: Option<&'a (dyn Fn(u64) + Sync)>,
+    /// Called after each complete pass with the film and the samples every pixel now has: the
+    /// film then equals a render with that many spp, bit for bit (`lapidary tradeoff` takes its
+    /// convergence curves this way).
+    pub on_pass: Option<&'a (dyn Fn(&Film, u32) + Sync)>,
 }
 
 /// Figures of a finished (or stopped) render.
@@ -200,6 +205,9 @@ fn render_passes(
             break;
         }
         done = end;
+        if let Some(on_pass) = control.on_pass {
+            on_pass(&film, done);
+        }
     }
     (film, partial, done)
 }

@@ -1,0 +1,170 @@
+//! Effects on demand: for each implemented effect, a scene that does not call for it rendered with
+//! the effect's code left alone (`auto`), forced off (`forced-off`) and forced on (`forced-on`).
+//! The three renders are bit-identical (checked here before timing, and in `tests/effects.rs`);
+//! the issue asks that `auto` be no slower than `forced-off`, and `forced-on` shows what the code
+//! of an effect costs when it runs for nothing.
+//!
+//! Scenes (the same as in `tests/effects.rs`, on the studio stage): clear coats for
+//! `absorption`, uncoated materials for `t-term` (forcing it on in a coated Corrected scene would
+//! change the model, so that is not an on-demand comparison), nested Voronoi maps without a bump
+//! for `facet-bump`, a hard marble switch for `glitter-overlay` and `stochastic-switch`, the
+//! studio's pinhole camera for `depth-of-field`, a gradient sky as the only light for
+//! `environment-importance`. Each is 64 × 48 pixels, 16 spp, Sobol', max depth 8, on every core
+//! (`LAPIDARY_BENCH_SIZE=W` renders W × 3W/4); the world is built outside the timed closure.
+//!
+//! Times are the **process's CPU time** on 64-bit Linux (all render threads), so other builds and
+//! tests on a small machine inflate them less than wall time; elsewhere wall time. Run with
+//! `cargo bench --bench effects` (about two minutes); a filter narrows it, e.g.
+//! `cargo bench --bench effects -- absorption`. No number here is asserted anywhere.
+
+use criterion::Criterion;
+use lapidary::recipe::GemRecipe;
+use lapidary::render::{Control, Film, World, render};
+use lapidary::scene::{Accuracy, Effect, Scene};
+use std::hint::black_box;
+use std::time::Duration;
+
+#[path = "common/clock.rs"]
+mod clock;
+
+use clock::Clock;
+
+fn width() -> u32 {
+    std::env::var("LAPIDARY_BENCH_SIZE")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .filter(|w| *w >= 4)
+        .unwrap_or(64)
+}
+
+fn compile(text: &str) -> Scene {
+    let mut s = GemRecipe::parse("effects-bench.ron", text)
+        .and_then(|r| r.compile())
+        .unwrap_or_else(|e| panic!("the bench scene compiles: {e}"));
+    let r = &mut s.stage.render;
+    r.width = width();
+    r.height = width() * 3 / 4;
+    r.spp = 16;
+    r.max_depth = 8;
+    r.sampler = lapidary::sampler::SamplerKind::Sobol;
+    s
+}
+
+/// A recipe on the studio stage.
+fn studio(materials: &str, surface: &str) -> String {
+    format!("(materials: {{ {materials} }}, surface: {surface})")
+}
+
+/// For each implemented effect, a scene that does not call for it.
+fn scenes() -> Vec<(Effect, Scene)> {
+    let bare = studio(
+        r#""clay": (base: Lambert(albedo: Gray(0.6))),
+           "gold": (base: Conductor(metal: Gold, roughness: 8.0))"#,
+        r#"Voronoi(scale: 0.2, entries: [(1.0, Material("clay")), (1.0, Material("gold"))])"#,
+    );
+    let clear_coats = studio(
+        r#""clear": (coats: [(ior: 1.5, roughness: 3.0, thickness: 1.0)], base: Lambert(albedo: Gray(0.5))),
+           "thin": (coats: [(ior: 1.6, roughness: 6.0, absorption: Rgb(0.5, 1.0, 2.0))],
+                    base: Conductor(metal: Gold, roughness: 4.0)),
+           "double": (coats: [(ior: 1.4, roughness: 2.0, thickness: 2.0, absorption: Gray(0.0)),
+                              (ior: 1.7, roughness: 9.0, thickness: 0.5)],
+                      base: Lambert(albedo: Rgb(0.2, 0.5, 0.3)), model: Course)"#,
+        r#"Voronoi(scale: 0.15, entries: [(1.0, Material("clear")), (1.0, Material("thin")),
+                                         (1.0, Material("double"))])"#,
+    );
+    let nested = studio(
+        r#""a": (base: Lambert(albedo: Gray(0.3))),
+           "b": (coats: [(ior: 1.5, roughness: 1.0)], base: Conductor(metal: Silver, roughness: 2.0)),
+           "c": (base: Lambert(albedo: Rgb(0.6, 0.3, 0.2)))"#,
+        r#"Voronoi(scale: 0.4, entries: [
+               (1.0, Voronoi(scale: 0.07, entries: [(1.0, Material("a")), (1.0, Material("b"))])),
+               (1.0, Material("c"))])"#,
+    );
+    let hard_switch = studio(
+        r#""a": (base: Lambert(albedo: Gray(0.3))),
+           "b": (coats: [(ior: 1.5, roughness: 2.0)], base: Lambert(albedo: Rgb(0.7, 0.4, 0.6))),
+           "vein": (base: Lambert(albedo: Gray(0.9)))"#,
+        r#"Switch(by: Marble(scale: 0.5, turbulence: 0.6),
+                  stops: [(0.0, Voronoi(scale: 0.08, entries: [(1.0, Material("a")), (1.0, Material("b"))])),
+                          (0.6, Material("vein"))])"#,
+    );
+    let sky = r#"(materials: { "g": (coats: [(ior: 1.5, roughness: 10.0)], base: Lambert(albedo: Gray(0.5))) },
+                  surface: Material("g"),
+                  stage: (lights: [], environment: Gradient(zenith: Rgb(0.2, 0.4, 1.0), horizon: Gray(1.0),
+                                                            nadir: Rgb(0.5, 0.3, 0.1))))"#;
+    vec![
+        (Effect::Absorption, compile(&clear_coats)),
+        (Effect::TTerm, compile(&bare)),
+        (Effect::FacetBump, compile(&nested)),
+        (Effect::GlitterOverlay, compile(&hard_switch)),
+        (Effect::StochasticSwitch, compile(&hard_switch)),
+        (Effect::DepthOfField, compile(&bare)),
+        (Effect::EnvironmentImportance, compile(sky)),
+    ]
+}
+
+/// `scene` with `effect` forced `on`.
+fn forced(scene: &Scene, effect: Effect, on: bool) -> Scene {
+    let mut s = scene.clone();
+    let mut acc = Accuracy::default();
+    acc.force(effect, on);
+    s.set_accuracy(&acc, "benches/effects.rs")
+        .expect("implemented effects can be forced");
+    s
+}
+
+fn run(world: &World, scene: &Scene) -> Film {
+    render(
+        world,
+        &scene.stage.camera,
+        scene.effects.on(Effect::DepthOfField),
+        &scene.stage.render,
+        &Control::default(),
+    )
+    .film
+}
+
+fn bench(c: &mut Criterion<Clock>) {
+    clock::select(clock::Kind::Process);
+    for (effect, scene) in scenes() {
+        assert!(
+            !scene.effects.called(effect),
+            "the {effect} bench scene must not call for it"
+        );
+        let variants = [
+            ("auto", scene.clone()),
+            ("forced-off", forced(&scene, effect, false)),
+            ("forced-on", forced(&scene, effect, true)),
+        ];
+        let worlds: Vec<World> = variants
+            .iter()
+            .map(|(_, s)| World::new(s).expect("world builds"))
+            .collect();
+        let reference = run(&worlds[0], &variants[0].1);
+        let mut group = c.benchmark_group(format!("effects/{}", effect.name()));
+        group.sample_size(10);
+        group.warm_up_time(Duration::from_millis(500));
+        group.measurement_time(Duration::from_secs(3));
+        for ((name, s), world) in variants.iter().zip(&worlds) {
+            assert!(
+                run(world, s) == reference,
+                "{effect} {name}: the film differs from auto"
+            );
+            group.bench_function(*name, |b| b.iter(|| black_box(run(world, s))));
+        }
+        group.finish();
+    }
+}
+
+fn config() -> Criterion<Clock> {
+    Criterion::default()
+        .with_measurement(clock::measurement())
+        .without_plots()
+}
+
+criterion::criterion_group! {
+    name = benches;
+    config = config();
+    targets = bench
+}
+criterion::criterion_main!(benches);

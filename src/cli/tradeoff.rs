@@ -1,0 +1,471 @@
+//! `lapidary tradeoff RECIPE`: what accuracy costs in time (DESIGN §7). It renders a converged
+//! reference (Reference model, exact Fresnel, deep paths, many samples; cached in the output
+//! folder), then renders the recipe once per knob setting for a fixed time budget, capturing the
+//! film at every power-of-two spp ([`crate::render::study`]). For each setting it reports the
+//! time and the error (relMSE, HDR-FLIP, the stone's energy against the reference) at equal spp
+//! and at equal time, prints a table, and writes `tradeoff.csv` (a row per setting),
+//! `tradeoff-curves.csv` (a row per capture) and `tradeoff.png` (error against time, log-log,
+//! one series per setting).
+
+use super::knobs::KnobArgs;
+use super::render::parse_size;
+use crate::image::{read_exr, write_exr};
+use crate::recipe::GemRecipe;
+use crate::render::study::{Convergence, Errors, Reference, converge};
+use crate::render::{Control, Metadata, World, exr_image, render};
+use crate::sampler::{SamplerKind, hash_words};
+use crate::scene::{Effect, Knobs, Scene};
+use anyhow::{Context, Result, anyhow};
+use clap::Args;
+use indicatif::{ProgressBar, ProgressStyle};
+use rayon::prelude::*;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+/// The settings studied when none are given: the recipe as written, then one knob changed at a
+/// time.
+pub const DEFAULT_SETTINGS: [&str; 13] = [
+    "baseline",
+    "model=course",
+    "model=reference",
+    "fresnel=schlick",
+    "fresnel=table",
+    "t-term=on",
+    "absorption=off",
+    "bump=off",
+    "sampler=independent",
+    "max-depth=2",
+    "max-depth=4",
+    "max-depth=16",
+    "model=course,fresnel=table",
+];
+
+/// Arguments of `lapidary tradeoff`.
+#[derive(Debug, Args)]
+pub struct TradeoffArgs {
+    /// Gem recipe (RON).
+    pub recipe: PathBuf,
+    /// Render time per setting in seconds: each setting renders until then (equal time).
+    #[arg(long, default_value_t = 10.0, value_parser = parse_budget)]
+    pub budget: f64,
+    /// Image size `WxH` in pixels.
+    #[arg(long, value_parser = parse_size, default_value = "160x120")]
+    pub size: (u32, u32),
+    /// Output folder: tables, plot, and the cached reference.
+    #[arg(long, default_value = "tradeoff-out")]
+    pub out: PathBuf,
+    /// The equal-spp comparison point (a power of two ≥ 4).
+    #[arg(long, default_value_t = 16, value_parser = parse_spp)]
+    pub spp: u32,
+    /// A knob setting `key=value,…` (repeatable; default: the built-in list, see the README).
+    /// Keys: model, fresnel, t-term, absorption, bump, sampler, max-depth and any effect name.
+    #[arg(long = "setting")]
+    pub settings: Vec<String>,
+    /// Samples per pixel of the reference.
+    #[arg(long, default_value_t = 4096, value_parser = clap::value_parser!(u32).range(16..=1_048_576))]
+    pub ref_spp: u32,
+    /// Longest path of the reference, in scattering events.
+    #[arg(long, default_value_t = 32, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub ref_depth: u32,
+    /// Seed of the settings' pixel samples (the reference uses an unrelated one).
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Worker threads (default: one per core).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub threads: Option<u32>,
+    /// Knobs applied to the baseline before every setting (e.g. `--bump off`).
+    #[command(flatten)]
+    pub knobs: KnobArgs,
+    /// No progress output.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+fn parse_budget(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if (0.05..=86_400.0).contains(&v) => Ok(v),
+        _ => Err(format!("`{s}`: expected seconds in 0.05..=86400")),
+    }
+}
+
+fn parse_spp(s: &str) -> Result<u32, String> {
+    match s.parse::<u32>() {
+        Ok(v) if v >= 4 && v <= 1 << 20 && v.is_power_of_two() => Ok(v),
+        _ => Err(format!("`{s}`: expected a power of two in 4..=1048576")),
+    }
+}
+
+/// One studied setting and its measurements.
+#[derive(Clone, Debug)]
+pub struct Row {
+    /// The setting as written.
+    pub label: String,
+    /// Seconds to build the world (material tables).
+    pub setup: f64,
+    /// Paths per second over the whole render.
+    pub paths_per_second: f64,
+    /// Each capture's spp, seconds and errors.
+    pub curve: Vec<(u32, f64, Errors)>,
+    /// The equal-time capture.
+    pub last: Option<(u32, f64, Errors)>,
+    /// The relMSE left with infinitely many samples: the intercept `b` of a least-squares fit
+    /// `relMSE ≈ a / spp + b` over the captures from 16 spp (the bias of an approximation; ≈ 0
+    /// for an unbiased setting).
+    pub bias: Option<f64>,
+}
+
+/// Least-squares intercept of `y = a x + b` over `(x, y)`; `None` for fewer than 3 points.
+pub fn intercept(points: &[(f64, f64)]) -> Option<f64> {
+    if points.len() < 3 {
+        return None;
+    }
+    let n = points.len() as f64;
+    let (sx, sy) = points
+        .iter()
+        .fold((0.0, 0.0), |(a, b), p| (a + p.0, b + p.1));
+    let (mx, my) = (sx / n, sy / n);
+    let (sxx, sxy) = points.iter().fold((0.0, 0.0), |(a, b), p| {
+        (a + (p.0 - mx) * (p.0 - mx), b + (p.0 - mx) * (p.1 - my))
+    });
+    if sxx <= 0.0 {
+        return None;
+    }
+    Some(my - sxy / sxx * mx)
+}
+
+/// Runs `lapidary tradeoff`.
+pub fn run(args: &TradeoffArgs) -> Result<()> {
+    let labels: Vec<String> = if args.settings.is_empty() {
+        DEFAULT_SETTINGS.iter().map(|s| s.to_string()).collect()
+    } else {
+        args.settings.clone()
+    };
+    let settings: Vec<Knobs> = labels
+        .iter()
+        .map(|l| l.parse().map_err(|e| anyhow!("--setting `{l}`: {e}")))
+        .collect::<Result<_>>()?;
+    let recipe = GemRecipe::load(&args.recipe).map_err(|e| anyhow!("{e}"))?;
+    let mut base = recipe.compile().map_err(|e| anyhow!("{e}"))?;
+    let (w, h) = args.size;
+    base.stage.render.width = w;
+    base.stage.render.height = h;
+    base.stage.render.seed = args.seed;
+    args.knobs
+        .apply(&mut base)
+        .map_err(|e| anyhow!("{}: {e}", args.recipe.display()))?;
+    // Check every setting before the long renders.
+    for (k, l) in settings.iter().zip(&labels) {
+        k.apply(&mut base.clone(), "tradeoff")
+            .map_err(|e| anyhow!("--setting `{l}`: {e}"))?;
+    }
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("creating {}", args.out.display()))?;
+    let name = args
+        .recipe
+        .file_stem()
+        .map_or("recipe".into(), |s| s.to_string_lossy().to_string());
+    let threads = args.threads.map(|t| t as usize);
+
+    let reference = reference(args, &base, &name, threads)?;
+    let budget = Duration::from_secs_f64(args.budget);
+    let mut rows = Vec::with_capacity(settings.len());
+    for (i, (knobs, label)) in settings.iter().zip(&labels).enumerate() {
+        let mut scene = base.clone();
+        knobs
+            .apply(&mut scene, "tradeoff")
+            .map_err(|e| anyhow!("--setting `{label}`: {e}"))?;
+        let spinner = spinner(
+            args.quiet,
+            format!("[{}/{}] {label}", i + 1, settings.len()),
+        );
+        let t0 = Instant::now();
+        let world = World::new(&scene).map_err(|e| anyhow!("{}: {e}", args.recipe.display()))?;
+        let setup = t0.elapsed().as_secs_f64();
+        let conv = converge(&world, &scene, budget, 1 << 20, threads);
+        spinner.finish_and_clear();
+        rows.push(measure(label, setup, &conv, &reference));
+    }
+    let table = table(args, &rows, &reference);
+    print!("{table}");
+    write_csv(&args.out.join("tradeoff.csv"), &summary_csv(args, &rows))?;
+    write_csv(&args.out.join("tradeoff-curves.csv"), &curves_csv(&rows))?;
+    let plot = args.out.join("tradeoff.png");
+    super::tradeoff_plot::plot(&name, &rows, reference.noise_floor(), &plot)?;
+    println!(
+        "wrote {}, {}, {}",
+        args.out.join("tradeoff.csv").display(),
+        args.out.join("tradeoff-curves.csv").display(),
+        plot.display()
+    );
+    Ok(())
+}
+
+fn spinner(quiet: bool, msg: String) -> ProgressBar {
+    if quiet {
+        return ProgressBar::hidden();
+    }
+    let s = ProgressBar::new_spinner();
+    s.set_style(
+        ProgressStyle::with_template("{spinner} [{elapsed}] {msg}")
+            .unwrap_or_else(|_| ProgressStyle::default_spinner()),
+    );
+    s.set_message(msg);
+    s.enable_steady_tick(Duration::from_millis(200));
+    s
+}
+
+/// Loads the cached reference or renders it (Reference model, exact Fresnel, `--ref-depth`,
+/// `--ref-spp`, independent sampler, a seed unrelated to the settings').
+fn reference(
+    args: &TradeoffArgs,
+    base: &Scene,
+    name: &str,
+    threads: Option<usize>,
+) -> Result<Reference> {
+    let mut scene = base.clone();
+    let knobs: Knobs = "model=reference,fresnel=exact".parse()?;
+    knobs.apply(&mut scene, "tradeoff reference")?;
+    let r = &mut scene.stage.render;
+    r.spp = args.ref_spp;
+    r.max_depth = args.ref_depth;
+    // Independent samples make the reference's variance an honest estimate of its error, which
+    // the relMSE subtracts (see `study::Errors`).
+    r.sampler = SamplerKind::Independent;
+    r.seed = hash_words(&[args.seed, 0x7e_f5ee_d]);
+    let key = hash_words(&[
+        scene.hash,
+        u64::from(r.width),
+        u64::from(r.height),
+        u64::from(r.spp),
+        u64::from(r.max_depth),
+        r.seed,
+        hash_words(&scene.accuracy.to_string().bytes().map(u64::from).collect::<Vec<_>>()),
+        hash_words(
+            &env!("CARGO_PKG_VERSION")
+                .bytes()
+                .map(u64::from)
+                .collect::<Vec<_>>(),
+        ),
+    ]);
+    let path = args.out.join(format!("{name}-reference-{key:016x}.exr"));
+    if let Ok(img) = read_exr(&path) {
+        if let Ok(reference) = Reference::from_exr(&img)
+            && (img.width, img.height) == (r.width, r.height)
+        {
+            if !args.quiet {
+                eprintln!("reference: {} (cached)", path.display());
+            }
+            return Ok(reference);
+        }
+    }
+    let spinner = spinner(
+        args.quiet,
+        format!(
+            "reference: {}×{}, {} spp, Reference model, depth {}",
+            r.width, r.height, r.spp, r.max_depth
+        ),
+    );
+    let world = World::new(&scene).map_err(|e| anyhow!("{}: {e}", args.recipe.display()))?;
+    let control = Control {
+        threads,
+        ..Control::default()
+    };
+    let rendered = render(
+        &world,
+        &scene.stage.camera,
+        scene.effects.on(Effect::DepthOfField),
+        &scene.stage.render,
+        &control,
+    );
+    spinner.finish_and_clear();
+    let meta = Metadata::of(&args.recipe.display().to_string(), &scene);
+    let img = exr_image(&rendered, &meta);
+    write_exr(&path, &img).with_context(|| format!("writing {}", path.display()))?;
+    if !args.quiet {
+        eprintln!(
+            "reference: {} ({:.1} s)",
+            path.display(),
+            rendered.stats.elapsed.as_secs_f64()
+        );
+    }
+    Reference::from_exr(&img).map_err(|e| anyhow!(e))
+}
+
+fn measure(label: &str, setup: f64, conv: &Convergence, reference: &Reference) -> Row {
+    let curve: Vec<(u32, f64, Errors)> = conv
+        .snapshots
+        .par_iter()
+        .map(|s| (s.spp, s.seconds, reference.errors(&s.rgb)))
+        .collect();
+    let last = conv
+        .last
+        .as_ref()
+        .map(|s| (s.spp, s.seconds, reference.errors(&s.rgb)));
+    let secs = conv.stats.elapsed.as_secs_f64().max(1e-9);
+    let fit: Vec<(f64, f64)> = conv
+        .snapshots
+        .iter()
+        .zip(&curve)
+        .filter(|(s, _)| s.spp >= 16)
+        .map(|(s, c): (_, &(u32, f64, Errors))| (1.0 / f64::from(s.spp), c.2.rel_mse))
+        .collect();
+    Row {
+        bias: intercept(&fit),
+        label: label.to_string(),
+        setup,
+        paths_per_second: conv.stats.paths as f64 / secs,
+        curve,
+        last,
+    }
+}
+
+fn at_spp(row: &Row, spp: u32) -> Option<(f64, Errors)> {
+    row.curve
+        .iter()
+        .find(|(s, _, _)| *s == spp)
+        .map(|&(_, t, e)| (t, e))
+}
+
+fn cell(v: Option<f64>, fmt: fn(f64) -> String) -> String {
+    v.filter(|v| v.is_finite()).map_or("—".to_string(), fmt)
+}
+
+fn table(args: &TradeoffArgs, rows: &[Row], reference: &Reference) -> String {
+    let mut o = String::new();
+    let _ = writeln!(
+        o,
+        "\n{}: {}×{}; equal spp = {} spp, equal time = {} s per setting; reference noise (relMSE) {:.2e}",
+        args.recipe.display(),
+        args.size.0,
+        args.size.1,
+        args.spp,
+        args.budget,
+        reference.noise_floor()
+    );
+    let _ = writeln!(
+        o,
+        "{:<28} {:>7} {:>8} | {:>8} {:>9} {:>7} {:>7} | {:>6} {:>9} {:>7} {:>7} | {:>9}",
+        "setting",
+        "setup s",
+        "Mpath/s",
+        "time s",
+        "relMSE",
+        "FLIP",
+        "energy",
+        "spp",
+        "relMSE",
+        "FLIP",
+        "energy",
+        "bias"
+    );
+    let sci = |v: f64| format!("{v:.2e}");
+    let f3 = |v: f64| format!("{v:.3}");
+    let f4 = |v: f64| format!("{v:.4}");
+    for r in rows {
+        let eq = at_spp(r, args.spp);
+        let _ = writeln!(
+            o,
+            "{:<28} {:>7.2} {:>8.3} | {:>8} {:>9} {:>7} {:>7} | {:>6} {:>9} {:>7} {:>7} | {:>9}",
+            r.label,
+            r.setup,
+            r.paths_per_second / 1e6,
+            cell(eq.map(|e| e.0), f3),
+            cell(eq.map(|e| e.1.rel_mse), sci),
+            cell(eq.map(|e| e.1.flip), f4),
+            cell(eq.map(|e| e.1.stone_ratio), f4),
+            r.last.map_or("—".into(), |l| l.0.to_string()),
+            cell(r.last.map(|l| l.2.rel_mse), sci),
+            cell(r.last.map(|l| l.2.flip), f4),
+            cell(r.last.map(|l| l.2.stone_ratio), f4),
+            cell(r.bias, sci),
+        );
+    }
+    let _ = writeln!(
+        o,
+        "(left: at {} spp and the time it took; right: after {} s. relMSE: against the true image, the \
+         reference's noise subtracted; energy: the stone's luminance over the reference's; bias: the relMSE \
+         left at infinite spp, from a fit a/spp + b)",
+        args.spp, args.budget
+    );
+    o
+}
+
+fn summary_csv(args: &TradeoffArgs, rows: &[Row]) -> String {
+    let mut o = String::from(
+        "setting,setup_s,paths_per_s,equal_spp,equal_spp_time_s,equal_spp_relmse,\
+         equal_spp_relmse_raw,equal_spp_flip,equal_spp_energy,equal_time_budget_s,equal_time_spp,\
+         equal_time_s,equal_time_relmse,equal_time_relmse_raw,equal_time_flip,equal_time_energy,\
+         bias_relmse\n",
+    );
+    let num = |v: Option<f64>| v.filter(|v| v.is_finite()).map_or(String::new(), |v| format!("{v:.6e}"));
+    for r in rows {
+        let eq = at_spp(r, args.spp);
+        let _ = writeln!(
+            o,
+            "\"{}\",{:.4},{:.0},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            r.label,
+            r.setup,
+            r.paths_per_second,
+            args.spp,
+            num(eq.map(|e| e.0)),
+            num(eq.map(|e| e.1.rel_mse)),
+            num(eq.map(|e| e.1.rel_mse_raw)),
+            num(eq.map(|e| e.1.flip)),
+            num(eq.map(|e| e.1.stone_ratio)),
+            args.budget,
+            r.last.map_or(String::new(), |l| l.0.to_string()),
+            num(r.last.map(|l| l.1)),
+            num(r.last.map(|l| l.2.rel_mse)),
+            num(r.last.map(|l| l.2.rel_mse_raw)),
+            num(r.last.map(|l| l.2.flip)),
+            num(r.last.map(|l| l.2.stone_ratio)),
+            num(r.bias),
+        );
+    }
+    o
+}
+
+fn curves_csv(rows: &[Row]) -> String {
+    let mut o = String::from("setting,spp,time_s,relmse,relmse_raw,flip,energy\n");
+    for r in rows {
+        for (spp, t, e) in &r.curve {
+            let _ = writeln!(
+                o,
+                "\"{}\",{spp},{t:.6},{:.6e},{:.6e},{:.6e},{:.6}",
+                r.label, e.rel_mse, e.rel_mse_raw, e.flip, e.stone_ratio
+            );
+        }
+    }
+    o
+}
+
+fn write_csv(path: &Path, text: &str) -> Result<()> {
+    super::write_atomically(path, |tmp| {
+        std::fs::write(tmp, text).with_context(|| format!("writing {}", path.display()))
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn intercept_of_a_line() {
+        let pts: Vec<(f64, f64)> = [4.0, 8.0, 16.0, 32.0]
+            .iter()
+            .map(|s| (1.0 / s, 0.3 / s + 0.002))
+            .collect();
+        assert!((intercept(&pts).unwrap() - 0.002).abs() < 1e-12);
+        assert_eq!(intercept(&pts[..2]), None);
+    }
+
+    #[test]
+    fn default_settings_parse() {
+        for s in DEFAULT_SETTINGS {
+            assert!(s.parse::<Knobs>().is_ok(), "{s}");
+        }
+        assert!(parse_spp("12").is_err() && parse_spp("2").is_err() && parse_spp("64").is_ok());
+        assert!(parse_budget("0").is_err() && parse_budget("3.5").is_ok());
+    }
+}
