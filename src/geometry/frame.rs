@@ -41,6 +41,11 @@ impl Frame {
     /// vector with `z > 0`): `n' = to_world(local_n)`, `s'` is `s` made orthogonal to `n'`
     /// (Gram–Schmidt, so the tangent turns with the facet rather than jumping), `t' = n' × s'`.
     pub fn tilted(&self, local_n: Vec3) -> Frame {
+        // An untilted normal leaves the frame exactly as it is (renormalising would round it, and
+        // a 0° facet bump must render as no bump, bit for bit).
+        if local_n == Vec3::Z {
+            return *self;
+        }
         let n = self.to_world(local_n).normalize();
         let s = self.s - n * n.dot(self.s);
         if s.length_squared() < 1e-8 || !n.is_finite() {
@@ -61,6 +66,16 @@ impl Frame {
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn an_untilted_normal_keeps_the_frame_bit_for_bit() {
+        for k in 0..1000 {
+            let a = k as f32 * 0.618;
+            let n = Vec3::new(a.sin() * 0.7, a.cos(), (3.0 * a).sin() * 0.4).normalize();
+            let f = Frame::from_normal(n);
+            assert_eq!(f.tilted(Vec3::Z), f);
+        }
+    }
     use super::*;
 
     fn orthonormal(f: &Frame) {

@@ -12,7 +12,7 @@
 //! | `bump` (`facet-bump`) | facet normals are ignored | facet frames are used wherever a map gives one |
 //! | `glitter-overlay` | an `Overlay` shows only its `under` map | (no code to force) |
 //! | `stochastic-switch` | switches are hard (`blend` ignored) | (no code to force) |
-//! | `depth-of-field` | a pinhole camera | the thin-lens code runs even at aperture 0 |
+//! | `depth-of-field` | a pinhole camera | the thin-lens path is taken (at aperture 0 it gives the pinhole ray) |
 //! | `environment-importance` | an environment map is sampled uniformly | (no code to force) |
 //!
 //! Render-level knobs (spp, sampler, maximum depth) live in the render settings; [`Knobs`] bundles
