@@ -9,8 +9,9 @@
 //! change the model, so that is not an on-demand comparison), nested Voronoi maps without a bump
 //! for `facet-bump`, a hard marble switch for `glitter-overlay` and `stochastic-switch`, the
 //! studio's pinhole camera for `depth-of-field`, a gradient sky as the only light for
-//! `environment-importance`. Each is 64 × 48 pixels, 16 spp, Sobol', max depth 8, on every core
-//! (`LAPIDARY_BENCH_SIZE=W` renders W × 3W/4); the world is built outside the timed closure.
+//! `environment-importance`. Each is 64 × 48 pixels, 16 spp, Sobol', max depth 8
+//! (`LAPIDARY_BENCH_SIZE=W` renders W × 3W/4), on one worker thread; the world is built outside
+//! the timed closure.
 //!
 //! Times are the **process's CPU time** on 64-bit Linux (all render threads), so other builds and
 //! tests on a small machine inflate them less than wall time; elsewhere wall time. Run with
@@ -119,7 +120,12 @@ fn run(world: &World, scene: &Scene) -> Film {
         &scene.stage.camera,
         scene.effects.on(Effect::DepthOfField),
         &scene.stage.render,
-        &Control::default(),
+        // One worker: no work stealing or idle spinning between the threads, whose scheduling
+        // noise on a 2-core machine was larger (±10 %) than the differences looked for.
+        &Control {
+            threads: Some(1),
+            ..Control::default()
+        },
     )
     .film
 }
@@ -142,9 +148,9 @@ fn bench(c: &mut Criterion<Clock>) {
             .collect();
         let reference = run(&worlds[0], &variants[0].1);
         let mut group = c.benchmark_group(format!("effects/{}", effect.name()));
-        group.sample_size(10);
+        group.sample_size(20);
         group.warm_up_time(Duration::from_millis(500));
-        group.measurement_time(Duration::from_secs(3));
+        group.measurement_time(Duration::from_secs(4));
         for ((name, s), world) in variants.iter().zip(&worlds) {
             assert!(
                 run(world, s) == reference,

@@ -41,7 +41,11 @@ fn csv(path: &std::path::Path) -> Vec<Vec<String>> {
     std::fs::read_to_string(path)
         .unwrap()
         .lines()
-        .map(|l| l.split(',').map(|c| c.trim_matches('"').to_string()).collect())
+        .map(|l| {
+            l.split(',')
+                .map(|c| c.trim_matches('"').to_string())
+                .collect()
+        })
         .collect()
 }
 
@@ -53,7 +57,10 @@ fn tables_plot_energy_gain_and_a_cached_reference() {
     let out = tradeoff(&s, &settings);
     let stdout = text(&out.stdout);
     assert!(out.status.success(), "{stdout}{}", text(&out.stderr));
-    assert!(stdout.contains("baseline") && stdout.contains("model=course"), "{stdout}");
+    assert!(
+        stdout.contains("baseline") && stdout.contains("model=course"),
+        "{stdout}"
+    );
 
     // One row per setting, every column filled where the budget allowed.
     let rows = csv(&s.path("out/tradeoff.csv"));
@@ -63,14 +70,24 @@ fn tables_plot_energy_gain_and_a_cached_reference() {
     let col = |name: &str| header.iter().position(|h| h == name).unwrap();
     for r in &rows[1..] {
         assert_eq!(r.len(), header.len(), "{r:?}");
-        for name in ["equal_spp_time_s", "equal_spp_relmse", "equal_time_spp", "equal_time_flip"] {
-            let v: f64 = r[col(name)].parse().unwrap_or_else(|_| panic!("{name}: {r:?}"));
+        for name in [
+            "equal_spp_time_s",
+            "equal_spp_relmse",
+            "equal_time_spp",
+            "equal_time_flip",
+        ] {
+            let v: f64 = r[col(name)]
+                .parse()
+                .unwrap_or_else(|_| panic!("{name}: {r:?}"));
             assert!(v.is_finite(), "{name}: {r:?}");
         }
     }
     let energy = |row: &Vec<String>| row[col("equal_time_energy")].parse::<f64>().unwrap();
     let (base, course) = (energy(&rows[1]), energy(&rows[2]));
-    assert!((0.9..1.1).contains(&base), "Corrected vs Reference energy {base}");
+    assert!(
+        (0.9..1.1).contains(&base),
+        "Corrected vs Reference energy {base}"
+    );
     assert!(course > 1.15 * base, "Course {course} vs Corrected {base}");
     let relmse = |row: &Vec<String>| row[col("equal_time_relmse")].parse::<f64>().unwrap();
     assert!(relmse(&rows[2]) > 2.0 * relmse(&rows[1]), "{rows:?}");
@@ -95,8 +112,15 @@ fn tables_plot_energy_gain_and_a_cached_reference() {
     let before = std::fs::read(s.path(&format!("out/{}", refs[0]))).unwrap();
     let out = tradeoff(&s, &["--setting", "baseline"]);
     assert!(out.status.success(), "{}", text(&out.stderr));
-    assert!(text(&out.stderr).contains("(cached)"), "{}", text(&out.stderr));
-    assert_eq!(std::fs::read(s.path(&format!("out/{}", refs[0]))).unwrap(), before);
+    assert!(
+        text(&out.stderr).contains("(cached)"),
+        "{}",
+        text(&out.stderr)
+    );
+    assert_eq!(
+        std::fs::read(s.path(&format!("out/{}", refs[0]))).unwrap(),
+        before
+    );
     assert_eq!(csv(&s.path("out/tradeoff.csv")).len(), 2);
 }
 
@@ -105,7 +129,10 @@ fn bad_settings_are_refused_before_rendering() {
     let s = Scratch::new("tradeoff", "bad");
     std::fs::write(s.path("gold.ron"), RECIPE).unwrap();
     for (args, expect) in [
-        (vec!["--setting", "model=fast"], "course, corrected, reference"),
+        (
+            vec!["--setting", "model=fast"],
+            "course, corrected, reference",
+        ),
         (vec!["--setting", "bump"], "key=value"),
         (vec!["--setting", "spectral=on"], "does not simulate"),
         (vec!["--spp", "12"], "power of two"),

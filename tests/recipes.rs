@@ -230,7 +230,10 @@ fn render_accuracy_knobs_rewrite_materials_and_force_effects() {
          bump: false, effects: {{\"depth-of-field\": true}}))))"
     ));
     let stack = &s.surface.stacks[0];
-    assert_eq!((stack.model, stack.fresnel), (Model::Course, FresnelMode::Table));
+    assert_eq!(
+        (stack.model, stack.fresnel),
+        (Model::Course, FresnelMode::Table)
+    );
     assert_eq!(stack.coats[0].absorption.max_channel(), 0.0);
     // Absorption is gone from what the scene calls for; the Course model turned the t term on.
     assert!(!s.effects.called(Effect::Absorption) && !s.effects.on(Effect::Absorption));
@@ -239,7 +242,10 @@ fn render_accuracy_knobs_rewrite_materials_and_force_effects() {
     assert!(s.effects.called(Effect::FacetBump) && !s.effects.on(Effect::FacetBump));
     assert!(!s.effects.called(Effect::DepthOfField) && s.effects.on(Effect::DepthOfField));
     let by = s.effects.forced_by(Effect::FacetBump).unwrap();
-    assert!(by.contains("render.accuracy") && by.contains("t.ron:"), "{by}");
+    assert!(
+        by.contains("render.accuracy") && by.contains("t.ron:"),
+        "{by}"
+    );
     assert_eq!(
         s.accuracy.to_string(),
         "model=course,fresnel=table,absorption=off,bump=off,depth-of-field=on"
@@ -255,7 +261,9 @@ fn render_accuracy_knobs_rewrite_materials_and_force_effects() {
         "({M} stage: (render: (accuracy: (effects: {{\"sparkle\": true}}))))"
     ));
     assert!(
-        e.contains("t.ron:") && e.contains("unknown effect \"sparkle\"") && e.contains("facet-bump"),
+        e.contains("t.ron:")
+            && e.contains("unknown effect \"sparkle\"")
+            && e.contains("facet-bump"),
         "{e}"
     );
     let e = err(format!("({M} stage: (render: (accuracy: (speed: 2))))"));

@@ -91,7 +91,7 @@ fn parse_budget(s: &str) -> Result<f64, String> {
 
 fn parse_spp(s: &str) -> Result<u32, String> {
     match s.parse::<u32>() {
-        Ok(v) if v >= 4 && v <= 1 << 20 && v.is_power_of_two() => Ok(v),
+        Ok(v) if (4..=1 << 20).contains(&v) && v.is_power_of_two() => Ok(v),
         _ => Err(format!("`{s}`: expected a power of two in 4..=1048576")),
     }
 }
@@ -232,7 +232,7 @@ fn reference(
     // Independent samples make the reference's variance an honest estimate of its error, which
     // the relMSE subtracts (see `study::Errors`).
     r.sampler = SamplerKind::Independent;
-    r.seed = hash_words(&[args.seed, 0x7e_f5ee_d]);
+    r.seed = hash_words(&[args.seed, 0x07ef_5eed]);
     let key = hash_words(&[
         scene.hash,
         u64::from(r.width),
@@ -240,7 +240,14 @@ fn reference(
         u64::from(r.spp),
         u64::from(r.max_depth),
         r.seed,
-        hash_words(&scene.accuracy.to_string().bytes().map(u64::from).collect::<Vec<_>>()),
+        hash_words(
+            &scene
+                .accuracy
+                .to_string()
+                .bytes()
+                .map(u64::from)
+                .collect::<Vec<_>>(),
+        ),
         hash_words(
             &env!("CARGO_PKG_VERSION")
                 .bytes()
@@ -249,15 +256,14 @@ fn reference(
         ),
     ]);
     let path = args.out.join(format!("{name}-reference-{key:016x}.exr"));
-    if let Ok(img) = read_exr(&path) {
-        if let Ok(reference) = Reference::from_exr(&img)
-            && (img.width, img.height) == (r.width, r.height)
-        {
-            if !args.quiet {
-                eprintln!("reference: {} (cached)", path.display());
-            }
-            return Ok(reference);
+    if let Ok(img) = read_exr(&path)
+        && let Ok(reference) = Reference::from_exr(&img)
+        && (img.width, img.height) == (r.width, r.height)
+    {
+        if !args.quiet {
+            eprintln!("reference: {} (cached)", path.display());
         }
+        return Ok(reference);
     }
     let spinner = spinner(
         args.quiet,
@@ -398,7 +404,10 @@ fn summary_csv(args: &TradeoffArgs, rows: &[Row]) -> String {
          equal_time_s,equal_time_relmse,equal_time_relmse_raw,equal_time_flip,equal_time_energy,\
          bias_relmse\n",
     );
-    let num = |v: Option<f64>| v.filter(|v| v.is_finite()).map_or(String::new(), |v| format!("{v:.6e}"));
+    let num = |v: Option<f64>| {
+        v.filter(|v| v.is_finite())
+            .map_or(String::new(), |v| format!("{v:.6e}"))
+    };
     for r in rows {
         let eq = at_spp(r, args.spp);
         let _ = writeln!(

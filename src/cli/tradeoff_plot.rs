@@ -99,7 +99,11 @@ pub fn plot(name: &str, rows: &[Row], floor: f64, path: &Path) -> Result<()> {
             chart
                 .configure_mesh()
                 .x_desc("render time (s)")
-                .y_desc(if metric == 0 { "relMSE" } else { "mean HDR-FLIP" })
+                .y_desc(if metric == 0 {
+                    "relMSE"
+                } else {
+                    "mean HDR-FLIP"
+                })
                 .x_labels(8)
                 .y_labels(8)
                 .y_label_formatter(&|v| short(*v))

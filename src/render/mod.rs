@@ -35,6 +35,9 @@ use std::time::{Duration, Instant};
 /// Tile edge in pixels.
 pub const TILE: u32 = 16;
 
+/// A callback after each complete pass: the film and the spp every pixel has.
+pub type PassCallback<'a> = &'a (dyn Fn(&Film, u32) + Sync);
+
 /// How a render is run (not what it renders).
 #[derive(Default)]
 pub struct Control<'a> {
@@ -51,7 +54,7 @@ pub struct Control<'a> {
     /// Called after each complete pass with the film and the samples every pixel now has: the
     /// film then equals a render with that many spp, bit for bit (`lapidary tradeoff` takes its
     /// convergence curves this way).
-    pub on_pass: Option<&'a (dyn Fn(&Film, u32) + Sync)>,
+    pub on_pass: Option<PassCallback<'a>>,
 }
 
 /// Figures of a finished (or stopped) render.

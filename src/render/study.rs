@@ -87,7 +87,7 @@ pub fn converge(
         st.last = Some(snap);
         st.overhead += t.elapsed();
     };
-    let mut settings = scene.stage.render.clone();
+    let mut settings = scene.stage.render;
     settings.spp = max_spp;
     let control = Control {
         threads,
@@ -181,7 +181,9 @@ impl Reference {
     pub fn errors(&self, test: &[[f32; 3]]) -> Errors {
         let (mut rel, mut raw, mut count) = (0.0, 0.0, 0usize);
         let (mut lum_t, mut lum_r) = (0.0f64, 0.0f64);
-        let lum = |p: &[f32; 3]| 0.2126 * f64::from(p[0]) + 0.7152 * f64::from(p[1]) + 0.0722 * f64::from(p[2]);
+        let lum = |p: &[f32; 3]| {
+            0.2126 * f64::from(p[0]) + 0.7152 * f64::from(p[1]) + 0.0722 * f64::from(p[2])
+        };
         for (i, (t, r)) in test.iter().zip(&self.rgb).enumerate() {
             if !(t.iter().chain(r).all(|v| v.is_finite())) {
                 continue;
@@ -202,7 +204,13 @@ impl Reference {
         let flip = hdr_flip(test, &self.rgb, self.width, self.height, DEFAULT_PPD)
             .flip
             .mean;
-        let mean = |x: f64| if count == 0 { f64::NAN } else { x / count as f64 };
+        let mean = |x: f64| {
+            if count == 0 {
+                f64::NAN
+            } else {
+                x / count as f64
+            }
+        };
         Errors {
             rel_mse: mean(rel),
             rel_mse_raw: mean(raw),
