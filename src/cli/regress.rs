@@ -9,9 +9,8 @@ use crate::image::compare::{Comparison, compare};
 use crate::image::write_heatmap;
 use crate::image::{ExrImage, read_exr, write_exr};
 use crate::recipe::GemRecipe;
-use crate::render::{Control, Metadata, World, exr_image, render};
+use crate::render::{Control, Metadata, World, exr_image, render_scene};
 use crate::sampler::SamplerKind;
-use crate::scene::Effect;
 use anyhow::{Result, anyhow, bail};
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -82,13 +81,7 @@ fn render_recipe(
         threads: threads.map(|t| t as usize),
         ..Control::default()
     };
-    let rendered = render(
-        &world,
-        &scene.stage.camera,
-        scene.effects.on(Effect::DepthOfField),
-        &scene.stage.render,
-        &control,
-    );
+    let rendered = render_scene(&world, &scene, &control);
     Ok(exr_image(
         &rendered,
         &Metadata::of(&recipe.display().to_string(), &scene),

@@ -12,9 +12,9 @@ use super::render::parse_size;
 use crate::image::{read_exr, write_exr};
 use crate::recipe::GemRecipe;
 use crate::render::study::{Convergence, Errors, Reference, converge};
-use crate::render::{Control, Metadata, World, exr_image, render};
+use crate::render::{Control, Metadata, World, exr_image, render_scene};
 use crate::sampler::{SamplerKind, hash_words};
-use crate::scene::{Effect, Knobs, Scene};
+use crate::scene::{Knobs, Scene};
 use anyhow::{Context, Result, anyhow};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -277,13 +277,7 @@ fn reference(
         threads,
         ..Control::default()
     };
-    let rendered = render(
-        &world,
-        &scene.stage.camera,
-        scene.effects.on(Effect::DepthOfField),
-        &scene.stage.render,
-        &control,
-    );
+    let rendered = render_scene(&world, &scene, &control);
     spinner.finish_and_clear();
     let meta = Metadata::of(&args.recipe.display().to_string(), &scene);
     let img = exr_image(&rendered, &meta);

@@ -3,7 +3,7 @@
 //! setting's curve flattens at its bias; an unbiased one keeps falling with slope −1 (relMSE)
 //! until it meets the floor.
 
-use super::plot::register_font;
+use super::plot::{register_font, save_png};
 use super::tradeoff::Row;
 use anyhow::{Result, anyhow};
 use plotters::prelude::*;
@@ -158,9 +158,5 @@ pub fn plot(name: &str, rows: &[Row], floor: f64, path: &Path) -> Result<()> {
         }
         root.present().map_err(e)?;
     }
-    let img = image::RgbImage::from_raw(W, H, buf).ok_or_else(|| anyhow!("plot: buffer size"))?;
-    super::write_atomically(path, |tmp| {
-        img.save_with_format(tmp, image::ImageFormat::Png)
-            .map_err(|e| anyhow!("{}: {e}", path.display()))
-    })
+    save_png(buf, W, H, path)
 }

@@ -129,6 +129,18 @@ pub fn render(
     }
 }
 
+/// Renders a compiled scene with its own camera and render settings, the lens used when depth of
+/// field is on (what `lapidary render`, `regress` and `tradeoff` do).
+pub fn render_scene(world: &World, scene: &crate::scene::Scene, control: &Control) -> Rendered {
+    render(
+        world,
+        &scene.stage.camera,
+        scene.effects.on(crate::scene::Effect::DepthOfField),
+        &scene.stage.render,
+        control,
+    )
+}
+
 fn render_passes(
     world: &World,
     camera: &Camera,

@@ -9,11 +9,11 @@
 //! ([`crate::image::flip`]), and the stone's mean luminance relative to the reference's, which
 //! shows a model's energy gain or loss apart from noise.
 
-use super::{Control, RenderStats, World, render};
+use super::{Control, RenderStats, World, render_scene};
 use crate::image::ExrImage;
 use crate::image::compare::REL_MSE_EPSILON;
 use crate::image::flip::{DEFAULT_PPD, hdr_flip};
-use crate::scene::{Effect, Scene};
+use crate::scene::Scene;
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
@@ -87,21 +87,15 @@ pub fn converge(
         st.last = Some(snap);
         st.overhead += t.elapsed();
     };
-    let mut settings = scene.stage.render;
-    settings.spp = max_spp;
+    let mut scene = scene.clone();
+    scene.stage.render.spp = max_spp;
     let control = Control {
         threads,
         deadline: Some(start + budget),
         on_pass: Some(&capture),
         ..Control::default()
     };
-    let rendered = render(
-        world,
-        &scene.stage.camera,
-        scene.effects.on(Effect::DepthOfField),
-        &settings,
-        &control,
-    );
+    let rendered = render_scene(world, &scene, &control);
     let st = state.into_inner().unwrap_or_else(|e| e.into_inner());
     let mut stats = rendered.stats;
     stats.elapsed = stats.elapsed.saturating_sub(st.overhead);

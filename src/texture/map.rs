@@ -443,11 +443,12 @@ pub fn choose_stop(stops: &[Stop], v: f32, blend: f32, u: &mut f32) -> usize {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::texture::bump::Tilt;
 
-    fn voronoi(first: u32, count: u32, fill: f32, seed: u64) -> MapNode {
+    /// A Voronoi node (cell spacing 0.1, jitter 1) whose filled cells carry a 10° cone bump.
+    pub(crate) fn voronoi(first: u32, count: u32, fill: f32, seed: u64) -> MapNode {
         MapNode::Voronoi(VoronoiNode {
             basis: Voronoi::new(seed, 1.0),
             inv_scale: 10.0,

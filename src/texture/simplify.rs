@@ -40,8 +40,9 @@ impl Map {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::texture::map::{Entry, Stop, VoronoiNode};
-    use crate::texture::{FacetBump, FieldNode, FieldTable, Tilt, Voronoi};
+    use crate::texture::map::tests::voronoi;
+    use crate::texture::map::{Entry, Stop};
+    use crate::texture::{FieldNode, FieldTable};
     use glam::Vec3;
 
     const ALL: MapEffects = MapEffects {
@@ -49,19 +50,6 @@ mod tests {
         blend: true,
         bump: true,
     };
-
-    fn voronoi(first: u32, count: u32, fill: f32, seed: u64) -> MapNode {
-        MapNode::Voronoi(VoronoiNode {
-            basis: Voronoi::new(seed, 1.0),
-            inv_scale: 10.0,
-            first,
-            count,
-            fill,
-            bump: Some(FacetBump {
-                tilt: Tilt::Cone { half_angle: 10.0 },
-            }),
-        })
-    }
 
     /// Materials 0–3: a sparse glitter Voronoi (material 2) over a dense one (0 or 1), both under
     /// a switch on `x` with a blend band of 0.4 around 0.5 whose upper stop is material 3.
