@@ -1,4 +1,5 @@
-//! End-to-end tests of `lapidary brdf` through the built binary.
+//! End-to-end tests of `lapidary brdf` through the built binary, and of every command writing to a
+//! closed standard output.
 
 use std::io::Write;
 use std::process::{Command, Output, Stdio};
@@ -217,4 +218,27 @@ fn plot_writes_a_png_and_a_failed_plot_keeps_the_old_file() {
     assert_eq!(std::fs::read(&png).unwrap(), bytes);
     let leftovers = std::fs::read_dir(&dir).unwrap().count();
     assert_eq!(leftovers, 1, "no temporary files left behind");
+}
+
+/// Standard output closed before the command writes (as with `| head`): no panic, whatever the
+/// subcommand. `info` and `brdf` write after some work, so the pipe is closed by then.
+#[test]
+fn a_closed_stdout_ends_output_without_a_panic() {
+    let gem = concat!(env!("CARGO_MANIFEST_DIR"), "/gems/lepidolite.ron");
+    for args in [
+        vec!["info", gem, "--points", "20000"],
+        vec!["brdf", "materials/course.ron", "--list"],
+        vec!["check", gem],
+    ] {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_lapidary"))
+            .args(&args)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("binary runs");
+        drop(child.stdout.take());
+        let out = child.wait_with_output().unwrap();
+        let err = text(&out.stderr);
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+    }
 }

@@ -109,10 +109,10 @@ pub fn run(args: &CheckArgs) -> anyhow::Result<bool> {
         total += report.errors.len();
         if report.errors.is_empty() {
             if !args.quiet {
-                println!("{}: ok ({})", path.display(), report.summary);
+                outln!("{}: ok ({})", path.display(), report.summary);
             }
         } else {
-            println!(
+            outln!(
                 "{}: {} error{}",
                 path.display(),
                 report.errors.len(),

@@ -39,14 +39,14 @@ pub fn run(args: &CompareArgs) -> Result<Verdict> {
     let test = read_exr(&args.test)?;
     let reference = read_exr(&args.reference)?;
     let c = compare(&test, &reference).map_err(|e| describe(args, e))?;
-    print!("{}", report(&args.test, &args.reference, &c));
+    out!("{}", report(&args.test, &args.reference, &c));
     if let Some(path) = &args.heatmap {
         write_heatmap(path, &c)?;
         let top = match &c.ztest {
             Some(z) => format!("|z| ≥ {:.2}", z.z_crit),
             None => format!("relative error ≥ {}", c.error_scale),
         };
-        println!(
+        outln!(
             "  heatmap   {} (viridis, yellow = {top}, white = NaN/∞)",
             path.display()
         );
@@ -56,7 +56,7 @@ pub fn run(args: &CompareArgs) -> Result<Verdict> {
     } else {
         Verdict::Fail
     };
-    println!("  verdict   {}", verdict_line(&c));
+    outln!("  verdict   {}", verdict_line(&c));
     Ok(verdict)
 }
 

@@ -35,7 +35,7 @@ pub fn run(args: &InfoArgs) -> Result<()> {
     args.knobs
         .apply(&mut scene)
         .map_err(|e| anyhow!("{}: {e}", args.recipe.display()))?;
-    print!("{}", describe(&recipe, &scene, args.points));
+    out!("{}", describe(&recipe, &scene, args.points));
     Ok(())
 }
 

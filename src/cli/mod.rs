@@ -1,6 +1,23 @@
 //! The `lapidary` command line: argument definitions (clap derive) and dispatch. Each subcommand
 //! lives in its own file.
 
+/// `print!` that never panics: when standard output is closed (`lapidary info … | head`), the rest
+/// of the output is dropped instead of aborting with a panic.
+macro_rules! out {
+    ($($t:tt)*) => {{
+        use std::io::Write as _;
+        let _ = write!(std::io::stdout().lock(), $($t)*);
+    }};
+}
+
+/// `println!` that never panics (see [`out!`]).
+macro_rules! outln {
+    ($($t:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout().lock(), $($t)*);
+    }};
+}
+
 pub mod brdf;
 pub mod check;
 pub mod compare;

@@ -137,7 +137,7 @@ pub fn run(args: &RegressArgs) -> Result<Outcome> {
             )?;
             let out = recipe.with_extension("exr");
             write_exr(&out, &img)?;
-            println!(
+            outln!(
                 "{}: reference written ({} spp)",
                 out.display(),
                 args.ref_spp
@@ -145,9 +145,16 @@ pub fn run(args: &RegressArgs) -> Result<Outcome> {
         }
         return Ok(outcome);
     }
-    println!(
+    outln!(
         "{:<24} {:>9} {:>6} {:>10} {:>7} {:>9} {:>8} {:>8}  verdict",
-        "recipe", "size", "spp", "pixels ok", "max |z|", "relMSE", "PSNR dB", "time"
+        "recipe",
+        "size",
+        "spp",
+        "pixels ok",
+        "max |z|",
+        "relMSE",
+        "PSNR dB",
+        "time"
     );
     for recipe in &list {
         let name = recipe
@@ -159,7 +166,7 @@ pub fn run(args: &RegressArgs) -> Result<Outcome> {
         let reference = match read_exr(&ref_path) {
             Ok(r) => r,
             Err(e) => {
-                println!("{name:<24} unusable: {e} (make it with --update)");
+                outln!("{name:<24} unusable: {e} (make it with --update)");
                 outcome = Outcome::Unusable;
                 continue;
             }
@@ -175,7 +182,7 @@ pub fn run(args: &RegressArgs) -> Result<Outcome> {
         ) {
             Ok(t) => t,
             Err(e) => {
-                println!("{name:<24} unusable: {e}");
+                outln!("{name:<24} unusable: {e}");
                 outcome = Outcome::Unusable;
                 continue;
             }
@@ -184,12 +191,12 @@ pub fn run(args: &RegressArgs) -> Result<Outcome> {
         let c = match compare(&test, &reference) {
             Ok(c) => c,
             Err(e) => {
-                println!("{name:<24} unusable: {e}");
+                outln!("{name:<24} unusable: {e}");
                 outcome = Outcome::Unusable;
                 continue;
             }
         };
-        println!("{}", row(&name, &c, args.spp, secs));
+        outln!("{}", row(&name, &c, args.spp, secs));
         if !c.passed {
             std::fs::create_dir_all(&args.out)
                 .map_err(|e| anyhow!("{}: {e}", args.out.display()))?;
@@ -197,7 +204,7 @@ pub fn run(args: &RegressArgs) -> Result<Outcome> {
             let h = args.out.join(format!("{name}-heatmap.png"));
             write_exr(&t, &test)?;
             write_heatmap(&h, &c)?;
-            println!("    wrote {} and {}", t.display(), h.display());
+            outln!("    wrote {} and {}", t.display(), h.display());
             if outcome == Outcome::Pass {
                 outcome = Outcome::Fail;
             }

@@ -255,7 +255,7 @@ pub fn run(args: &RenderArgs) -> Result<bool> {
             .with_context(|| format!("writing {}", png.display()))?;
     }
     if !args.quiet {
-        print!(
+        out!(
             "{}",
             summary(
                 args,

@@ -187,12 +187,12 @@ pub fn run(args: &TradeoffArgs) -> Result<()> {
         rows.push(measure(label, setup, &conv, &reference));
     }
     let table = table(args, &rows, &reference);
-    print!("{table}");
+    out!("{table}");
     write_csv(&args.out.join("tradeoff.csv"), &summary_csv(args, &rows))?;
     write_csv(&args.out.join("tradeoff-curves.csv"), &curves_csv(&rows))?;
     let plot = args.out.join("tradeoff.png");
     super::tradeoff_plot::plot(&name, &rows, reference.noise_floor(), &plot)?;
-    println!(
+    outln!(
         "wrote {}, {}, {}",
         args.out.join("tradeoff.csv").display(),
         args.out.join("tradeoff-curves.csv").display(),
