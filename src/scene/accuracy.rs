@@ -3,7 +3,7 @@
 //! (`render: (accuracy: (…))`) and by `lapidary tradeoff --setting …`.
 //!
 //! A knob either rewrites what the scene asks for (the evaluation model and Fresnel mode of every
-//! material) or **forces an effect's code** on or off ([`Effects::force`]):
+//! material) or **forces an effect's code** on or off ([`super::Effects::force`]):
 //!
 //! | knob | forced off | forced on |
 //! |---|---|---|
