@@ -15,20 +15,51 @@ pub fn sobol_dim0(n: u32) -> u32 {
     n.reverse_bits()
 }
 
-/// The `n`-th point of Sobol' dimension 1 (primitive polynomial `x + 1`, all direction numbers
-/// `m_k = 1`), as 32 bits: generator column `k` is `v_k = v_{k−1} ⊕ (v_{k−1} >> 1)`, `v_0 = 2³¹`.
-#[inline]
-pub fn sobol_dim1(mut n: u32) -> u32 {
+/// Generator column `k` of Sobol' dimension 1 (primitive polynomial `x + 1`, all direction numbers
+/// `m_k = 1`), as 32 bits: `v_k = v_{k−1} ⊕ (v_{k−1} >> 1)`, `v_0 = 2³¹`.
+const fn dim1_column(k: u32) -> u32 {
     let mut v = 1u32 << 31;
-    let mut x = 0u32;
-    while n != 0 {
-        if n & 1 != 0 {
-            x ^= v;
-        }
-        n >>= 1;
+    let mut i = 0;
+    while i < k {
         v ^= v >> 1;
+        i += 1;
     }
-    x
+    v
+}
+
+/// `DIM1[b][x]`: the XOR of the generator columns `8b + j` for the set bits `j` of byte `x`, so a
+/// point is four lookups instead of a loop over the (after scrambling, usually 32) index bits.
+/// Computed at compile time; 4 KiB.
+static DIM1: [[u32; 256]; 4] = {
+    let mut t = [[0u32; 256]; 4];
+    let mut b = 0;
+    while b < 4 {
+        let mut x = 0;
+        while x < 256 {
+            let mut acc = 0u32;
+            let mut j = 0;
+            while j < 8 {
+                if x & (1 << j) != 0 {
+                    acc ^= dim1_column(8 * b as u32 + j);
+                }
+                j += 1;
+            }
+            t[b][x] = acc;
+            x += 1;
+        }
+        b += 1;
+    }
+    t
+};
+
+/// The `n`-th point of Sobol' dimension 1 (primitive polynomial `x + 1`, all direction numbers
+/// `m_k = 1`), as 32 bits: the XOR of the generator columns of `n`'s set bits (see [`DIM1`]).
+#[inline]
+pub fn sobol_dim1(n: u32) -> u32 {
+    DIM1[0][(n & 0xff) as usize]
+        ^ DIM1[1][((n >> 8) & 0xff) as usize]
+        ^ DIM1[2][((n >> 16) & 0xff) as usize]
+        ^ DIM1[3][(n >> 24) as usize]
 }
 
 /// The Laine–Karras permutation with the constants of Burley (2020), §3: a hash in which each bit
@@ -69,6 +100,33 @@ pub fn scrambled_pair(index: u32, seeds: [u32; 3]) -> (u32, u32) {
 
 #[cfg(test)]
 mod tests {
+
+    /// The generator matrix applied bit by bit, as the definition reads.
+    fn sobol_dim1_by_bits(mut n: u32) -> u32 {
+        let mut v = 1u32 << 31;
+        let mut x = 0u32;
+        while n != 0 {
+            if n & 1 != 0 {
+                x ^= v;
+            }
+            n >>= 1;
+            v ^= v >> 1;
+        }
+        x
+    }
+
+    #[test]
+    fn table_lookup_equals_the_generator_matrix() {
+        let mut n = 0x1234_5678u32;
+        for k in 0..200_000u32 {
+            // Small indices, every single bit, and a pseudo-random walk over all 32 bits.
+            for m in [k, 1u32.rotate_left(k), n] {
+                assert_eq!(sobol_dim1(m), sobol_dim1_by_bits(m), "n = {m:#x}");
+            }
+            n = n.wrapping_mul(0x9e37_79b9).wrapping_add(0x7f4a_7c15);
+        }
+        assert_eq!(sobol_dim1(u32::MAX), sobol_dim1_by_bits(u32::MAX));
+    }
     use super::*;
 
     /// Whether `pts` (2^m points, 32-bit coordinates) put exactly one point in every elementary
