@@ -3,7 +3,7 @@
 //! recipe's `render.accuracy` and every material's own choice ([`crate::scene::accuracy`]).
 
 use crate::bsdf::{FresnelMode, Model};
-use crate::scene::accuracy::{effect_named, parse_fresnel, parse_model};
+use crate::scene::accuracy::{effect_named, parse_fresnel, parse_model, parse_switch};
 use crate::scene::{Accuracy, Effect, KnobError, Scene};
 use clap::Args;
 
@@ -69,11 +69,7 @@ fn fresnel_arg(s: &str) -> Result<FresnelMode, String> {
 }
 
 fn switch_arg(s: &str) -> Result<bool, String> {
-    match s.to_ascii_lowercase().as_str() {
-        "on" | "true" => Ok(true),
-        "off" | "false" => Ok(false),
-        _ => Err(format!("`{s}` is not one of: on, off")),
-    }
+    parse_switch("value", s).map_err(|e| e.0)
 }
 
 fn effect_arg(s: &str) -> Result<(Effect, bool), String> {

@@ -4,7 +4,7 @@
 
 use crate::image::{Curve, ToneMap, write_exr, write_png};
 use crate::recipe::GemRecipe;
-use crate::render::{Control, Metadata, Rendered, Strategy, World, exr_image, render};
+use crate::render::{Control, Metadata, Rendered, Strategy, World, exr_image, render_scene};
 use crate::scene::stage::SamplerKind;
 use crate::scene::{Effect, Scene};
 use anyhow::{Context, Result, anyhow, bail};
@@ -235,8 +235,7 @@ pub fn run(args: &RenderArgs) -> Result<bool> {
         progress: Some(&progress),
         on_pass: None,
     };
-    let dof = scene.effects.on(Effect::DepthOfField);
-    let rendered = render(&world, &scene.stage.camera, dof, &r, &control);
+    let rendered = render_scene(&world, &scene, &control);
     bar.finish_and_clear();
     let was_interrupted = cancel.load(Ordering::SeqCst);
 

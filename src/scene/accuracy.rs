@@ -146,7 +146,8 @@ pub fn parse_fresnel(value: &str) -> Result<FresnelMode, KnobError> {
     }
 }
 
-fn parse_switch(key: &str, value: &str) -> Result<bool, KnobError> {
+/// `on`/`off` (also `true`/`false`, `yes`/`no`) for knob `key`.
+pub fn parse_switch(key: &str, value: &str) -> Result<bool, KnobError> {
     match value.to_ascii_lowercase().as_str() {
         "on" | "true" | "yes" => Ok(true),
         "off" | "false" | "no" => Ok(false),
