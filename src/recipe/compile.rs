@@ -15,10 +15,14 @@ use crate::texture::{
 };
 use glam::Vec3;
 use indexmap::IndexMap;
+use std::collections::HashSet;
 
 /// Deepest nesting of map nodes the compiler follows (through named maps too); the runtime tree
 /// has its own, equal limit ([`crate::texture::map::MAX_DEPTH`]).
 const MAX_NESTING: usize = crate::texture::map::MAX_DEPTH;
+
+/// Unknown names reported with a did-you-mean hint, at most.
+const MAX_HINTS: usize = 32;
 
 /// Compilation state: the flat runtime arrays being filled, children before parents.
 pub(crate) struct Compiler<'a> {
@@ -33,8 +37,8 @@ pub(crate) struct Compiler<'a> {
     counter: u64,
     /// Library index → surface material index, in first-use order after the recipe's own.
     materials: IndexMap<usize, u32>,
-    /// Unknown names already reported.
-    reported: Vec<String>,
+    /// Keys of the errors already reported once (unknown names, cycles, too deep).
+    reported: HashSet<String>,
     depth: usize,
     effects: Effects,
     errors: Vec<RecipeError>,
@@ -53,7 +57,7 @@ impl<'a> Compiler<'a> {
             named: IndexMap::new(),
             counter: 0,
             materials: (0..own).map(|i| (i, i as u32)).collect(),
-            reported: vec![],
+            reported: HashSet::new(),
             depth: 0,
             effects: Effects::default(),
             errors: vec![],
@@ -69,24 +73,38 @@ impl<'a> Compiler<'a> {
         let r = self.recipe;
         let own = r.content.materials.len();
         let root = self.node(&r.content.surface, "surface");
-        // Named maps the tree never reaches are still checked (in a scratch compiler, so the
-        // scene's tables and default seeds are those of the tree alone), and reported unused.
+        // Named maps the tree never reaches are still checked (in one scratch compiler, so the
+        // scene's tables and default seeds are those of the tree alone; each map is compiled
+        // once however many unused maps use it), and reported unused.
+        let mut scratch: Option<Compiler> = None;
         for (name, sub) in &r.content.maps {
-            if !self.named.contains_key(name) {
-                let mut scratch = Compiler::new(r);
-                scratch.named = self.named.clone();
-                scratch.named.insert(name.clone(), None);
-                scratch.node(sub, &format!("maps.{name:?}"));
-                for e in scratch.errors {
-                    if !self.errors.contains(&e) {
-                        self.errors.push(e);
-                    }
-                }
-                warnings.push(r.source.error(
-                    r.source.key(name),
-                    format!("map \"{name}\" is defined but the surface never uses it"),
-                ));
+            if self.named.contains_key(name) {
+                continue;
             }
+            let scratch = scratch.get_or_insert_with(|| {
+                let mut c = Compiler::new(r);
+                c.named = self.named.clone();
+                c.reported = self.reported.clone();
+                c
+            });
+            if !scratch.named.contains_key(name) {
+                scratch.named.insert(name.clone(), None);
+                let id = scratch.node(sub, &format!("maps.{name:?}"));
+                scratch.named.insert(name.clone(), Some(id));
+            }
+            warnings.push(r.source.error(
+                r.source.key(name),
+                format!("map \"{name}\" is defined but the surface never uses it"),
+            ));
+        }
+        if let Some(scratch) = scratch {
+            let seen: HashSet<String> = self.errors.iter().map(|e| e.to_string()).collect();
+            self.errors.extend(
+                scratch
+                    .errors
+                    .into_iter()
+                    .filter(|e| !seen.contains(&e.to_string())),
+            );
         }
         let mut used = vec![false; self.materials.len()];
         let (nodes, entries, stops, fields) = (
@@ -120,8 +138,7 @@ impl<'a> Compiler<'a> {
         for (lib_index, surface_index) in table {
             let name = r
                 .library
-                .names()
-                .nth(lib_index)
+                .name_at(lib_index)
                 .expect("indices come from the library")
                 .to_string();
             debug_assert_eq!(surface_index as usize, names.len());
@@ -244,16 +261,26 @@ impl<'a> Compiler<'a> {
         }
     }
 
-    /// Reports an unknown name once, at its first use in the file.
-    fn unknown(&mut self, kind: &str, name: &str, message: String) {
-        let at = self.recipe.source.find(&[kind, "(", &format!("{name:?}")]);
-        self.report_once(format!("{kind}({name})"), at, message);
+    /// Reports an unknown name once, at its first use in the file (the message is only made,
+    /// and the use only looked for, the first time).
+    fn unknown(&mut self, kind: &str, name: &str, message: impl FnOnce(&Self) -> String) {
+        let key = format!("{kind}({name})");
+        if !self.reported.contains(&key) {
+            let at = self.recipe.source.call(kind, name);
+            let message = message(self);
+            self.report_once(key, at, message);
+        }
+    }
+
+    /// Whether an unknown name still gets a did-you-mean: for the first [`MAX_HINTS`] errors only
+    /// (each hint compares the name with every known one).
+    fn hints(&self) -> bool {
+        self.reported.len() < MAX_HINTS
     }
 
     /// Pushes an error unless one with the same `key` was already reported.
     fn report_once(&mut self, key: String, at: Option<usize>, message: String) {
-        if !self.reported.contains(&key) {
-            self.reported.push(key);
+        if self.reported.insert(key) {
             self.errors.push(self.recipe.source.error(at, message));
         }
     }
@@ -264,7 +291,7 @@ impl<'a> Compiler<'a> {
             let message = format!(
                 "{at}: maps nest more than {MAX_NESTING} levels deep, too deep to evaluate"
             );
-            if !self.errors.iter().any(|e| e.message.contains("too deep")) {
+            if self.reported.insert("too deep".into()) {
                 // At the definition of the innermost named map on the path, else at `surface`.
                 let src = &self.recipe.source;
                 let pos = at
@@ -289,8 +316,9 @@ impl<'a> Compiler<'a> {
         match desc {
             MapDesc::Material(name) => {
                 let Some(lib_index) = r.library.index_of(name) else {
-                    let message = r.library.unknown(name);
-                    self.unknown("Material", name, message);
+                    self.unknown("Material", name, |c| {
+                        r.library.unknown_hinted(name, c.hints())
+                    });
                     return self.push(MapNode::Material(0));
                 };
                 let next = self.materials.len() as u32;
@@ -319,13 +347,19 @@ impl<'a> Compiler<'a> {
                     None => {}
                 }
                 let Some(sub) = r.content.maps.get(name) else {
-                    let hint = did_you_mean(name, r.content.maps.keys().map(String::as_str))
-                        .map(|s| format!(" (did you mean \"{s}\"?)"))
-                        .unwrap_or_default();
-                    let known: Vec<&str> = r.content.maps.keys().map(String::as_str).collect();
-                    self.unknown(
-                        "Map",
-                        name,
+                    self.unknown("Map", name, |c| {
+                        let maps = &r.content.maps;
+                        let hint = c
+                            .hints()
+                            .then(|| did_you_mean(name, maps.keys().map(String::as_str)))
+                            .flatten()
+                            .map(|s| format!(" (did you mean \"{s}\"?)"))
+                            .unwrap_or_default();
+                        let mut known: Vec<&str> =
+                            maps.keys().map(String::as_str).take(24).collect();
+                        if maps.len() > known.len() {
+                            known.push("…");
+                        }
                         format!(
                             "unknown map \"{name}\"{hint}; `maps` defines: {}",
                             if known.is_empty() {
@@ -333,8 +367,8 @@ impl<'a> Compiler<'a> {
                             } else {
                                 known.join(", ")
                             }
-                        ),
-                    );
+                        )
+                    });
                     return self.push(MapNode::Material(0));
                 };
                 self.named.insert(name.clone(), None);

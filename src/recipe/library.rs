@@ -13,7 +13,7 @@
 //! missing or unreadable include and a material name defined twice.
 
 use super::source::Source;
-use super::{MaterialDesc, RecipeError, did_you_mean, ron_options};
+use super::{MaterialDesc, RecipeError, did_you_mean};
 use crate::bsdf::{LayeredBsdf, Model, StackDesc};
 use indexmap::IndexMap;
 use serde::{Deserialize, Serialize};
@@ -90,10 +90,10 @@ impl MaterialLibrary {
         path: Option<&Path>,
         errors: &mut Vec<RecipeError>,
     ) -> Option<Self> {
-        let content: MaterialFile = match ron_options().from_str(&source.text) {
+        let content: MaterialFile = match source.parse() {
             Ok(c) => c,
             Err(e) => {
-                errors.push(source.ron_error(&e));
+                errors.push(e);
                 return None;
             }
         };
@@ -179,10 +179,10 @@ impl MaterialLibrary {
                     continue;
                 }
             };
-            let content: MaterialFile = match ron_options().from_str(&source.text) {
+            let content: MaterialFile = match source.parse() {
                 Ok(c) => c,
                 Err(e) => {
-                    errors.push(source.ron_error(&e));
+                    errors.push(e);
                     continue;
                 }
             };
@@ -201,9 +201,7 @@ impl MaterialLibrary {
             for (key, desc) in content.materials {
                 if let Some((_, earlier)) = self.materials.get(&key) {
                     let first = &self.sources[*earlier];
-                    let (line, col) = first
-                        .key(&key)
-                        .map_or((0, 0), |p| super::source::line_col(&first.text, p));
+                    let (line, col) = first.key(&key).map_or((0, 0), |p| first.line_col(p));
                     let here = &self.sources[index];
                     errors.push(here.error(
                         here.key(&key),
@@ -231,6 +229,11 @@ impl MaterialLibrary {
     /// Material names: the root file's own in file order, then included ones.
     pub fn names(&self) -> impl Iterator<Item = &str> {
         self.materials.keys().map(String::as_str)
+    }
+
+    /// The name of material `index` (in the order of [`MaterialLibrary::names`]).
+    pub fn name_at(&self, index: usize) -> Option<&str> {
+        self.materials.get_index(index).map(|(k, _)| k.as_str())
     }
 
     /// Number of materials.
@@ -264,9 +267,7 @@ impl MaterialLibrary {
     pub fn position_of(&self, name: &str) -> Option<String> {
         let (_, s) = self.materials.get(name)?;
         let source = &self.sources[*s];
-        let (line, col) = source
-            .key(name)
-            .map_or((0, 0), |p| super::source::line_col(&source.text, p));
+        let (line, col) = source.key(name).map_or((0, 0), |p| source.line_col(p));
         Some(format!("{}:{line}:{col}", source.file))
     }
 
@@ -285,7 +286,16 @@ impl MaterialLibrary {
 
     /// "unknown material …" with a did-you-mean and the known names.
     pub fn unknown(&self, name: &str) -> String {
-        let hint = did_you_mean(name, self.names())
+        self.unknown_hinted(name, true)
+    }
+
+    /// "unknown material …" with the known names, and a did-you-mean when `hint` (finding the
+    /// closest name costs a comparison with every name: callers reporting many unknown names
+    /// hint only the first few, so a file's check stays linear in its size).
+    pub fn unknown_hinted(&self, name: &str, hint: bool) -> String {
+        let hint = hint
+            .then(|| did_you_mean(name, self.names()))
+            .flatten()
             .map(|s| format!(" (did you mean \"{s}\"?)"))
             .unwrap_or_default();
         let mut known: Vec<&str> = self.names().take(24).collect();

@@ -8,6 +8,9 @@
 use super::RecipeError;
 use std::ops::Range;
 
+mod index;
+mod odd;
+
 /// Largest description file read (bytes): recipes are hand-written text, and the limit keeps a
 /// mistaken include of a huge or endless file (`/dev/zero`) from exhausting memory.
 pub const MAX_FILE_BYTES: u64 = 16 << 20;
@@ -19,17 +22,23 @@ pub struct Source {
     pub file: String,
     /// The text.
     pub text: String,
-    /// Byte ranges of comments.
+    /// Byte ranges of comments, in order.
     comments: Vec<Range<usize>>,
+    /// Line starts and key positions.
+    index: index::TextIndex,
 }
 
 impl Source {
-    /// A source over `text`, named `file` in messages.
+    /// A source over `text`, named `file` in messages; a leading UTF-8 byte-order mark is
+    /// dropped, so positions count from the character after it.
     pub fn new(file: &str, text: &str) -> Self {
+        let text = odd::strip_bom(text);
+        let comments = comment_ranges(text);
         Source {
             file: file.to_string(),
             text: text.to_string(),
-            comments: comment_ranges(text),
+            index: index::TextIndex::new(text, &comments),
+            comments,
         }
     }
 
@@ -78,7 +87,7 @@ impl Source {
 
     /// An error at byte offset `at` (or with no position when `at` is `None`).
     pub fn error(&self, at: Option<usize>, message: impl Into<String>) -> RecipeError {
-        let (line, col) = at.map_or((0, 0), |p| line_col(&self.text, p));
+        let (line, col) = at.map_or((0, 0), |p| self.line_col(p));
         RecipeError {
             file: self.file.clone(),
             line,
@@ -111,7 +120,7 @@ impl Source {
                 pos = self.refine(pos, &message).unwrap_or(pos);
             }
         }
-        let mut message = message;
+        let mut message = self.integer_detail(&e.code, pos).unwrap_or(message);
         if message.starts_with("Expected") && pos < self.text.len() {
             // Say what was found instead.
             let token: String = self.text[pos..]
@@ -249,8 +258,14 @@ impl Source {
         open - ident
     }
 
+    /// 1-based line and column (in characters) of byte offset `pos`.
+    pub fn line_col(&self, pos: usize) -> (usize, usize) {
+        self.index.line_col(&self.text, pos)
+    }
+
     fn in_comment(&self, pos: usize) -> bool {
-        self.comments.iter().any(|r| r.contains(&pos))
+        let i = self.comments.partition_point(|r| r.end <= pos);
+        self.comments.get(i).is_some_and(|r| r.contains(&pos))
     }
 
     /// Byte offsets of every occurrence, outside comments, of the token sequence `parts` (each
@@ -258,11 +273,23 @@ impl Source {
     /// parts must stand alone (not inside a longer identifier).
     pub fn find_all(&self, parts: &[&str]) -> Vec<usize> {
         let mut found = vec![];
-        let Some(first) = parts.first() else {
-            return found;
-        };
+        let mut from = 0;
+        while let Some(at) = self.find_from(from, parts) {
+            found.push(at);
+            from = at + 1;
+        }
+        found
+    }
+
+    /// The first occurrence of `parts` at or after byte `from`, outside comments (the search
+    /// starts at `from` and stops at the first match).
+    pub fn find_from(&self, from: usize, parts: &[&str]) -> Option<usize> {
+        let first = parts.first()?;
         let src = &self.text;
-        let mut start = 0;
+        let mut start = from.min(src.len());
+        while !src.is_char_boundary(start) {
+            start += 1;
+        }
         while let Some(off) = src[start..].find(first) {
             let at = start + off;
             start = at + first.len();
@@ -282,25 +309,27 @@ impl Source {
                 }
             });
             if ok {
-                found.push(at);
+                return Some(at);
             }
         }
-        found
-    }
-
-    /// The first occurrence of `parts` at or after byte `from`, outside comments.
-    pub fn find_from(&self, from: usize, parts: &[&str]) -> Option<usize> {
-        self.find_all(parts).into_iter().find(|&p| p >= from)
+        None
     }
 
     /// The first occurrence of `parts`, outside comments.
     pub fn find(&self, parts: &[&str]) -> Option<usize> {
-        self.find_all(parts).into_iter().next()
+        self.find_from(0, parts)
     }
 
-    /// Where the key `"name":` of a map (e.g. a material in `materials`) is written.
+    /// Where the key `"name":` of a map (e.g. a material in `materials`) is first written,
+    /// outside comments (looked up in an index built once, so locating many keys stays linear).
     pub fn key(&self, name: &str) -> Option<usize> {
-        self.find(&[&format!("\"{name}\""), ":"])
+        self.index.key(name)
+    }
+
+    /// Where the call `ident("name")` (e.g. `Material("gold")`) is first written outside
+    /// comments: the identifier (looked up in an index built once).
+    pub fn call(&self, ident: &str, name: &str) -> Option<usize> {
+        self.index.call(ident, name)
     }
 
     /// Locates the field a message starts with (e.g. `coats[1].ior: …`) within the entry whose key
