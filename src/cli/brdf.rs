@@ -13,6 +13,13 @@ use rayon::prelude::*;
 use std::io::{BufRead, Write};
 use std::path::PathBuf;
 
+/// Largest `--walks`: each Reference evaluation costs this many random walks.
+pub const MAX_WALKS: u32 = 4096;
+/// Largest `--sample N` (lines printed).
+pub const MAX_SAMPLE: u64 = 100_000_000;
+/// Largest `--samples` per albedo estimate (`--albedo` makes 90 estimates).
+pub const MAX_SAMPLES: u64 = 10_000_000;
+
 /// Evaluation model chosen on the command line.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum ModelArg {
@@ -76,17 +83,21 @@ pub struct BrdfArgs {
     /// Evaluation model; default: what the material says (Corrected unless it says otherwise).
     #[arg(long, value_enum)]
     pub model: Option<ModelArg>,
-    /// Random walks per evaluation for the Reference model (≥ 1).
-    #[arg(long, default_value_t = ReferenceParams::default().samples)]
+    /// Random walks per evaluation for the Reference model, 1 ..= 4096.
+    #[arg(long, default_value_t = ReferenceParams::default().samples,
+          value_parser = clap::value_parser!(u32).range(1..=i64::from(MAX_WALKS)))]
     pub walks: u32,
     /// Viewing direction `THETA_DEG[,PHI_DEG]` from the normal (0 ≤ θ < 90).
     #[arg(long, value_parser = parse_wo, default_value = "45,0", allow_hyphen_values = true)]
     pub wo: Wo,
-    /// Read directions `x y z` (wi, local frame) from stdin; print `f_r f_g f_b pdf` per line.
+    /// Read directions `x y z` (wi, local frame, any non-zero length: they are normalised) from
+    /// stdin; print `f_r f_g f_b pdf` per line.
     #[arg(long, group = "mode")]
     pub eval: bool,
-    /// Draw N samples; print `x y z w_r w_g w_b pdf` per line (a failed sample prints zeros).
-    #[arg(long, group = "mode", value_name = "N")]
+    /// Draw N samples, 1 ..= 10⁸; print `x y z w_r w_g w_b pdf` per line (a failed sample prints
+    /// zeros).
+    #[arg(long, group = "mode", value_name = "N",
+          value_parser = clap::value_parser!(u64).range(1..=MAX_SAMPLE))]
     pub sample: Option<u64>,
     /// Seed for --sample and --albedo.
     #[arg(long, default_value_t = 1)]
@@ -97,19 +108,25 @@ pub struct BrdfArgs {
     /// Plot in-plane slices at a few θo and the albedo curve, the three models overlaid.
     #[arg(long, group = "mode", value_name = "OUT.png")]
     pub plot: Option<PathBuf>,
-    /// Samples per albedo estimate (--albedo, --plot, and the catalogue summary).
-    #[arg(long, default_value_t = 50_000)]
+    /// Samples per albedo estimate (--albedo, --plot, and the catalogue summary), 1 ..= 10⁷.
+    #[arg(long, default_value_t = 50_000,
+          value_parser = clap::value_parser!(u64).range(1..=MAX_SAMPLES))]
     pub samples: u64,
 }
 
 /// Runs `lapidary brdf`.
 pub fn run(args: &BrdfArgs) -> Result<()> {
-    if args.walks == 0 {
-        bail!("--walks = 0 is out of range: allowed 1 ..");
-    }
-    if args.samples == 0 {
-        bail!("--samples = 0 is out of range: allowed 1 ..");
-    }
+    // The plot's path is checked before any work (see `crate::image::outputs`).
+    let plot_file = match &args.plot {
+        Some(p) => {
+            let mut plan = crate::image::outputs::OutputPlan::new();
+            if let Some(f) = &args.file {
+                plan.input(f, "the material library")?;
+            }
+            Some(plan.output(p, crate::image::outputs::Format::Png)?)
+        }
+        None => None,
+    };
     let lib = match &args.file {
         Some(p) => MaterialLibrary::load(p)?,
         None => MaterialLibrary::course(),
@@ -191,7 +208,8 @@ pub fn run(args: &BrdfArgs) -> Result<()> {
             model_of(ModelArg::Reference, args.walks.max(256)),
         ];
         let stacks: Vec<LayeredBsdf> = models.iter().map(|&m| bsdf.with_model(m)).collect();
-        plot::plot_stack(name, &stacks, args.samples.min(20_000), args.seed, path)?;
+        let file = plot_file.as_deref().unwrap_or(path);
+        plot::plot_stack(name, &stacks, args.samples.min(20_000), args.seed, file)?;
         writeln!(out, "wrote {}", path.display())?;
     } else {
         summary_one(name, &bsdf, args, &mut out)?;
@@ -218,29 +236,38 @@ fn eval_stdin(bsdf: &LayeredBsdf, wo: Vec3, out: &mut impl Write) -> Result<()> 
         if t.is_empty() || t.starts_with('#') {
             continue;
         }
-        let v: Vec<f32> = t
-            .split_whitespace()
-            .map(|x| x.parse::<f32>())
-            .collect::<Result<_, _>>()
-            .map_err(|_| {
-                anyhow::anyhow!("stdin:{}: expected three numbers `x y z`, got `{t}`", i + 1)
-            })?;
-        if v.len() != 3 || v.iter().any(|x| !x.is_finite()) {
-            bail!(
-                "stdin:{}: expected three finite numbers `x y z`, got `{t}`",
-                i + 1
-            );
-        }
-        let wi = Vec3::new(v[0], v[1], v[2]);
-        let len = wi.length();
-        if !(len > 1e-6) {
-            bail!("stdin:{}: the direction ({t}) has zero length", i + 1);
-        }
-        let wi = wi / len;
+        let wi = parse_direction(t).map_err(|e| anyhow::anyhow!("stdin:{}: {e}", i + 1))?;
         let f = bsdf.eval(wo, wi);
         writeln!(out, "{} {} {} {}", f[0], f[1], f[2], bsdf.pdf(wo, wi))?;
     }
     Ok(())
+}
+
+/// A direction `x y z` of any non-zero finite length, normalised. Read in double precision and
+/// divided by its largest component first, so lengths from 1e-300 to 1e300 all work.
+fn parse_direction(t: &str) -> Result<Vec3, String> {
+    let v: Vec<f64> = t
+        .split_whitespace()
+        .map(|x| x.parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("expected three numbers `x y z`, got `{t}`"))?;
+    let [x, y, z] = v[..] else {
+        return Err(format!("expected three numbers `x y z`, got `{t}`"));
+    };
+    if !(x.is_finite() && y.is_finite() && z.is_finite()) {
+        return Err(format!("expected three finite numbers `x y z`, got `{t}`"));
+    }
+    let m = x.abs().max(y.abs()).max(z.abs());
+    if m == 0.0 {
+        return Err(format!("the direction ({t}) has zero length"));
+    }
+    let (x, y, z) = (x / m, y / m, z / m);
+    let len = (x * x + y * y + z * z).sqrt();
+    Ok(Vec3::new(
+        (x / len) as f32,
+        (y / len) as f32,
+        (z / len) as f32,
+    ))
 }
 
 fn summary_one(
@@ -325,4 +352,28 @@ fn summary(lib: &MaterialLibrary, args: &BrdfArgs, out: &mut impl Write) -> Resu
         "Try: lapidary brdf --material silver_paint --plot silver_paint.png"
     )?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn directions_of_any_length_are_normalised() {
+        for t in ["0 0 1", "0 0 1e-300", "0 0 1e300", "3 0 4", "1e-40 0 1e-40"] {
+            let v = parse_direction(t).unwrap();
+            assert!((v.length() - 1.0).abs() < 1e-6, "{t}: {v}");
+        }
+        assert_eq!(parse_direction("0 0 5e-320").unwrap(), Vec3::Z);
+        let v = parse_direction("3e300 0 4e300").unwrap();
+        assert!((v - Vec3::new(0.6, 0.0, 0.8)).length() < 1e-6);
+        assert!(
+            parse_direction("0 0 0")
+                .unwrap_err()
+                .contains("zero length")
+        );
+        assert!(parse_direction("0 0 inf").unwrap_err().contains("finite"));
+        assert!(parse_direction("0 NaN 1").unwrap_err().contains("finite"));
+        assert!(parse_direction("0 1").is_err() && parse_direction("a b c").is_err());
+    }
 }

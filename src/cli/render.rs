@@ -203,6 +203,9 @@ pub fn run(args: &RenderArgs) -> Result<bool> {
         .apply(&mut scene)
         .map_err(|e| anyhow!("{}: {e}", args.recipe.display()))?;
     let world = World::new(&scene).map_err(|e| anyhow!("{}: {e}", args.recipe.display()))?;
+    for w in world.environment.warnings() {
+        eprintln!("warning: {}: {w}", args.recipe.display());
+    }
     let r = scene.stage.render;
 
     let total = u64::from(r.width) * u64::from(r.height) * u64::from(r.spp);

@@ -26,6 +26,7 @@ pub mod compare;
 pub mod exr;
 pub mod flip;
 pub mod heatmap;
+pub mod input_kind;
 pub mod png;
 pub mod stats;
 

@@ -25,6 +25,7 @@
 use super::distribution::Distribution2D;
 use super::{LightSample, positive_or_zero};
 use crate::color::Spectrum;
+use crate::image::input_kind::NotAFile;
 use crate::image::{ImageError, RgbImage, read_rgb};
 use crate::scene::stage::Environment;
 use glam::{Vec2, Vec3};
@@ -76,6 +77,30 @@ pub struct EnvironmentLight {
     invalid_pixels: usize,
 }
 
+/// Refuses a map no light can be made of: an infinite pixel (its radiance, and the sampling
+/// weight of every other pixel beside it, would be meaningless) or every pixel NaN.
+fn refuse_unusable(path: &std::path::Path, img: &RgbImage) -> Result<(), ImageError> {
+    let invalid = |reason: String| ImageError::Invalid {
+        path: path.into(),
+        reason,
+    };
+    let w = img.width.max(1) as usize;
+    let infinite = |p: &[f32; 3]| p.iter().any(|c| c.is_infinite());
+    if let Some(i) = img.pixels.iter().position(infinite) {
+        return Err(invalid(format!(
+            "pixel ({}, {}) is infinite: an environment map must hold finite radiance",
+            i % w,
+            i / w
+        )));
+    }
+    if !img.pixels.is_empty() && img.pixels.iter().all(|p| p.iter().any(|c| c.is_nan())) {
+        return Err(invalid(
+            "every pixel is NaN (not a number): the map holds no radiance".into(),
+        ));
+    }
+    Ok(())
+}
+
 /// `c` with negative or non-finite channels set to 0.
 fn sanitize(c: Spectrum) -> Spectrum {
     c.map(positive_or_zero)
@@ -104,7 +129,19 @@ impl EnvironmentLight {
                 path,
                 intensity,
                 rotate,
-            } => Self::from_image(&read_rgb(path)?, *intensity, *rotate),
+            } => {
+                // The file type first, without opening: a FIFO would block the reader.
+                crate::image::input_kind::regular_file(path).map_err(|e| match e {
+                    NotAFile::Missing => ImageError::NotFound { path: path.clone() },
+                    e => ImageError::Unreadable {
+                        path: path.clone(),
+                        reason: e.to_string(),
+                    },
+                })?;
+                let img = read_rgb(path)?;
+                refuse_unusable(path, &img)?;
+                Self::from_image(&img, *intensity, *rotate)
+            }
         })
     }
 
@@ -184,6 +221,31 @@ impl EnvironmentLight {
     /// other environments).
     pub fn invalid_pixels(&self) -> usize {
         self.invalid_pixels
+    }
+
+    /// What a user should hear about a map light that loaded but may not be what was meant: a map
+    /// that is black everywhere (it lights nothing, the background renders black), and pixels
+    /// that were NaN or negative and count as black. Empty for other environments.
+    pub fn warnings(&self) -> Vec<String> {
+        let Kind::Map(m) = &self.kind else {
+            return vec![];
+        };
+        let mut out = vec![];
+        if self.invalid_pixels > 0 {
+            out.push(format!(
+                "environment map: {} of {} pixels are NaN or negative and count as black",
+                self.invalid_pixels,
+                m.width * m.height
+            ));
+        }
+        if !(self.luminance_integral > 0.0) {
+            out.push(
+                "environment map: every pixel is black (after `intensity`): the environment \
+                 lights nothing and renders black"
+                    .into(),
+            );
+        }
+        out
     }
 
     /// True when the environment emits nothing.

@@ -42,7 +42,7 @@ use super::compile::Compiler;
 use super::source::Source;
 use super::stage::StageDesc;
 use super::surface::MapDesc;
-use super::{MaterialDesc, MaterialLibrary, RecipeError, ron_options};
+use super::{MaterialDesc, MaterialLibrary, RecipeError};
 use crate::scene::Scene;
 use indexmap::IndexMap;
 use serde::{Deserialize, Serialize};
@@ -53,7 +53,7 @@ use std::path::{Path, PathBuf};
 #[serde(deny_unknown_fields)]
 pub struct GemDesc {
     /// Recipe seed (default 0): every default Voronoi and noise seed derives from it.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "super::stage::any_seed")]
     pub seed: u64,
     /// Material libraries whose materials the tree may use, relative to this file.
     #[serde(default)]
@@ -110,9 +110,9 @@ impl GemRecipe {
     /// Parses and resolves includes, collecting every error.
     fn read(source: Source, path: Option<&Path>) -> (Option<Self>, Vec<RecipeError>) {
         let mut errors = vec![];
-        let content: GemDesc = match ron_options().from_str(&source.text) {
+        let content: GemDesc = match source.parse() {
             Ok(c) => c,
-            Err(e) => return (None, vec![source.ron_error(&e)]),
+            Err(e) => return (None, vec![e]),
         };
         let library = MaterialLibrary::assemble(
             source.clone(),

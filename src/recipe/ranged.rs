@@ -91,3 +91,61 @@ pub(crate) fn sizes_ok<E: serde::de::Error>(
         )))
     }
 }
+
+/// A whole number within `lo ..= hi` for the field `name`. Read from any RON number, so that a
+/// literal outside the field's type (`-1` or `99999999999999999999` for a `u64`, `5e9` for a
+/// `u32`) is reported at the number with the field's name and range, instead of as the parser's
+/// bare "Integer is out of bounds".
+pub(crate) fn whole<'de, D: serde::Deserializer<'de>>(
+    d: D,
+    name: &'static str,
+    lo: u64,
+    hi: u64,
+) -> Result<u64, D::Error> {
+    struct Visit {
+        name: &'static str,
+        lo: u64,
+        hi: u64,
+    }
+    impl Visit {
+        fn out<E: serde::de::Error>(&self, v: impl std::fmt::Display) -> E {
+            E::custom(format!(
+                "{} = {v} is out of range: allowed {} ..= {} (a whole number)",
+                self.name, self.lo, self.hi
+            ))
+        }
+    }
+    impl<'de> serde::de::Visitor<'de> for Visit {
+        type Value = u64;
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            write!(f, "a whole number {} ..= {}", self.lo, self.hi)
+        }
+        fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<u64, E> {
+            if (self.lo..=self.hi).contains(&v) {
+                Ok(v)
+            } else {
+                Err(self.out(v))
+            }
+        }
+        fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<u64, E> {
+            match u64::try_from(v) {
+                Ok(u) => self.visit_u64(u),
+                Err(_) => Err(self.out(v)),
+            }
+        }
+        fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<u64, E> {
+            if v.fract() == 0.0 && v >= self.lo as f64 && v <= self.hi as f64 {
+                Err(E::custom(format!(
+                    "{} = {v:?}: write a whole number, without a decimal point or exponent",
+                    self.name
+                )))
+            } else if v.abs() >= 9e15 {
+                // Beyond 2⁵³ the parser's float is not the literal's exact value.
+                Err(self.out(format!("{v:e}")))
+            } else {
+                Err(self.out(v))
+            }
+        }
+    }
+    d.deserialize_any(Visit { name, lo, hi })
+}

@@ -46,11 +46,12 @@ pub(crate) fn stage(
         if !ok_ext {
             errors.push(src.error(at, format!("{what} \"{name}\": expected a .{ext} file")));
             None
-        } else if !path.is_file() {
+        } else if let Err(e) = crate::image::input_kind::regular_file(&path) {
+            // Says "is a directory", "is a FIFO", … rather than "no such file".
             errors.push(src.error(
                 at,
                 format!(
-                    "{what} \"{name}\": no such file ({} relative to the recipe)",
+                    "{what} \"{name}\": {e} ({} relative to the recipe)",
                     path.display()
                 ),
             ));

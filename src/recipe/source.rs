@@ -106,6 +106,12 @@ impl Source {
         if pos >= self.text.len() {
             pos = reported; // nothing follows: keep the parser's position
         }
+        if pos > 0
+            && matches!(self.text.as_bytes()[pos - 1], b'-' | b'+')
+            && self.text[pos..].starts_with(|c: char| c.is_ascii_digit())
+        {
+            pos -= 1; // a number's sign is part of it (the parser reports after it)
+        }
         if matches!(e.code, ron::Error::Message(_)) {
             let before = self.text[..pos].trim_end();
             let close = if self.text[pos..].starts_with(')') {

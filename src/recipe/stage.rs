@@ -20,7 +20,7 @@
 
 use super::color::ColorDesc;
 use super::material::ModelDesc;
-use super::ranged::{finite, sizes_ok};
+use super::ranged::{finite, sizes_ok, whole};
 use crate::bsdf::FresnelMode;
 use indexmap::IndexMap;
 use serde::{Deserialize, Deserializer, Serialize};
@@ -67,13 +67,18 @@ fn base_range<'de, D: Deserializer<'de>>(d: D) -> Result<f32, D::Error> {
     }
 }
 
-/// A colour that is emitted light: finite and ≥ 0 in every channel.
+/// Largest radiance per channel a light or environment colour may have (relative units; the
+/// studio's key light is 4). With `intensity` (≤ 1e6) the product stays far from `f32`
+/// overflow, even squared for variance estimates, so an absurd value (1e30) is refused at parse.
+pub const MAX_RADIANCE: f32 = 1e6;
+
+/// A colour that is emitted light: within 0 ..= [`MAX_RADIANCE`] in every channel.
 fn radiance<'de, D: Deserializer<'de>>(d: D) -> Result<ColorDesc, D::Error> {
     let c = ColorDesc::deserialize(d)?;
     match c.to_spectrum() {
-        Ok(s) if s.0.iter().all(|v| *v >= 0.0) => Ok(c),
+        Ok(s) if s.0.iter().all(|v| (0.0..=MAX_RADIANCE).contains(v)) => Ok(c),
         Ok(s) => Err(serde::de::Error::custom(format!(
-            "radiance {:?} is out of range: each channel allowed 0 ..= any finite value",
+            "radiance {:?} is out of range: each channel allowed 0 ..= {MAX_RADIANCE:e}",
             s.0
         ))),
         Err(e) => Err(serde::de::Error::custom(e)),
@@ -93,20 +98,16 @@ fn albedo<'de, D: Deserializer<'de>>(d: D) -> Result<ColorDesc, D::Error> {
     }
 }
 
+/// A `u32` count in `lo ..= hi`; any number is read, so an overflowing literal still gets the
+/// field's name and range.
 fn count<'de, D: Deserializer<'de>>(
     d: D,
-    name: &str,
+    name: &'static str,
     lo: u32,
     hi: u32,
 ) -> Result<Option<u32>, D::Error> {
-    let v = u32::deserialize(d)?;
-    if (lo..=hi).contains(&v) {
-        Ok(Some(v))
-    } else {
-        Err(serde::de::Error::custom(format!(
-            "{name} = {v} is out of range: allowed {lo} ..= {hi}"
-        )))
-    }
+    let v = whole(d, name, lo.into(), hi.into())?;
+    Ok(Some(v as u32)) // within `hi`, a u32
 }
 
 fn size_range<'de, D: Deserializer<'de>>(d: D) -> Result<Option<u32>, D::Error> {
@@ -117,6 +118,13 @@ fn spp_range<'de, D: Deserializer<'de>>(d: D) -> Result<Option<u32>, D::Error> {
 }
 fn depth_range<'de, D: Deserializer<'de>>(d: D) -> Result<Option<u32>, D::Error> {
     count(d, "max_depth", 1, 1024)
+}
+fn seed_range<'de, D: Deserializer<'de>>(d: D) -> Result<Option<u64>, D::Error> {
+    any_seed(d).map(Some)
+}
+/// A seed: any `u64`, with the field's name and range when the literal is not one.
+pub(crate) fn any_seed<'de, D: Deserializer<'de>>(d: D) -> Result<u64, D::Error> {
+    whole(d, "seed", 0, u64::MAX)
 }
 
 fn zero3() -> V3 {
@@ -418,8 +426,8 @@ pub struct RenderDesc {
     /// Exposure of the PNG in stops (EV), −30 ..= 30.
     #[serde(default, deserialize_with = "exposure_opt")]
     pub exposure: Option<f32>,
-    /// Seed of the pixel samples (not of the maps: that is the recipe's `seed`).
-    #[serde(default)]
+    /// Seed of the pixel samples, 0 ..= 2⁶⁴ − 1 (not of the maps: that is the recipe's `seed`).
+    #[serde(default, deserialize_with = "seed_range")]
     pub seed: Option<u64>,
     /// Accuracy knobs for every material and forced effects (DESIGN §7).
     #[serde(default)]
