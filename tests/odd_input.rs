@@ -176,6 +176,26 @@ fn directories_fifos_and_devices_are_named_as_such() {
             "{name}: {e}"
         );
     }
+    // A recipe or an included library given as one.
+    std::fs::create_dir(s.path("dir.ron")).unwrap();
+    mkfifo(&s.path("pipe.ron"));
+    let out = lapidary(&["check", "dir.ron", "pipe.ron", "/dev/null"], &s.0);
+    let err = text(&out.stderr);
+    for words in [
+        "dir.ron: is a directory",
+        "pipe.ron: is a FIFO",
+        "/dev/null: is a device",
+    ] {
+        assert!(err.contains(words), "{words}: {err}");
+    }
+    let inc = "(include: [\"pipe.ron\"],\n materials: {}, surface: Material(\"x\"))";
+    std::fs::write(s.path("inc.ron"), inc).unwrap();
+    let out = lapidary(&["check", "inc.ron"], &s.0);
+    let err = text(&out.stderr);
+    assert!(
+        err.contains("include \"pipe.ron\"") && err.contains("is a FIFO"),
+        "{err}"
+    );
     // Through a recipe: the stage's file check says the same, at the file name.
     for (stage, words) in [
         ("shape: Mesh(file: \"dir.obj\")", "is a directory"),

@@ -51,11 +51,9 @@ impl Source {
             col: 0,
             message,
         };
-        let meta =
-            std::fs::metadata(path).map_err(|e| fail(format!("cannot read the file: {e}")))?;
-        if !meta.is_file() {
-            return Err(fail("not a regular file".into()));
-        }
+        // The type first, without opening: says "is a directory", "is a FIFO", … (a FIFO would
+        // block the read).
+        let meta = crate::image::input_kind::regular_file(path).map_err(|e| fail(e.to_string()))?;
         if meta.len() > MAX_FILE_BYTES {
             return Err(fail(format!(
                 "the file has {} bytes; description files may have at most {MAX_FILE_BYTES}",
