@@ -219,3 +219,135 @@ fn without_variance_the_verdict_comes_from_rel_mse() {
         "{report}"
     );
 }
+
+/// `img` with R, G, B multiplied by `gain`.
+fn brightened(mut img: ExrImage, gain: f32) -> ExrImage {
+    for c in img
+        .channels
+        .iter_mut()
+        .filter(|c| ["R", "G", "B"].contains(&&*c.name))
+    {
+        c.data.iter_mut().for_each(|v| *v *= gain);
+    }
+    img
+}
+
+#[test]
+fn a_bias_within_every_pixels_noise_fails_the_aggregate_test() {
+    // A 256-spp render 10 % brighter, against itself: no pixel's z reaches the limit (each
+    // has about 15 % noise), but the mean over tiles and the whole image moves far beyond it.
+    let s = Scratch::new("cli-compare", "bias");
+    s.render("ref.exr", 1.5, 256, 0);
+    write_exr(&s.path("bright.exr"), &brightened(exr(&s, "ref.exr"), 1.1)).unwrap();
+    let report = status(&s.compare("bright.exr", "ref.exr", &[]), 1);
+    assert!(
+        field(&report, "z-test").starts_with("100.00% of 768 pixels pass"),
+        "{report}"
+    );
+    assert!(
+        field(&report, "bias").contains("α 0.01 shared by 3 scales (Šidák)"),
+        "{report}"
+    );
+    for (label, tiles) in [
+        ("image", "1 tile "),
+        ("16x16", "4 tiles "),
+        ("8x8", "12 tiles "),
+    ] {
+        let line = field(&report, label);
+        assert!(line.starts_with(tiles), "{line}");
+        assert!(
+            line.contains("|z| max ") && line.contains("limit "),
+            "{line}"
+        );
+        assert!(
+            line.contains("FAIL (") && line.contains("tile at ("),
+            "{line}"
+        );
+    }
+    assert!(
+        field(&report, "verdict").starts_with("FAIL (bias at image: |z| "),
+        "{report}"
+    );
+    // The same file against itself passes every scale.
+    let report = status(&s.compare("ref.exr", "ref.exr", &[]), 0);
+    for label in ["image", "16x16", "8x8"] {
+        assert!(field(&report, label).ends_with("pass"), "{report}");
+    }
+}
+
+#[test]
+fn a_nan_infinite_or_negative_variance_is_unusable_input() {
+    let s = Scratch::new("cli-compare", "badvar");
+    s.render("ref.exr", 1.5, 16, 0);
+    for (k, bad) in [f32::NAN, f32::INFINITY, -1e-3].into_iter().enumerate() {
+        let mut img = exr(&s, "ref.exr");
+        let var = img
+            .channels
+            .iter_mut()
+            .find(|c| c.name == "variance.G")
+            .unwrap();
+        var.data[32 * 5 + 7] = bad;
+        let name = format!("bad{k}.exr");
+        write_exr(&s.path(&name), &img).unwrap();
+        // As the test, as the reference, and against itself: exit 2, never a verdict.
+        for (t, r) in [(&*name, "ref.exr"), ("ref.exr", &*name), (&*name, &*name)] {
+            let out = s.compare(t, r, &[]);
+            assert_eq!(status(&out, 2), "", "{t} vs {r}");
+            let err = text(&out.stderr);
+            assert!(
+                err.contains(&format!("{name}: `variance.G` is {bad} at pixel (7, 5)")),
+                "{err}"
+            );
+            assert!(err.contains("must be finite and ≥ 0"), "{err}");
+        }
+    }
+}
+
+#[test]
+fn without_variance_a_one_percent_bias_fails_on_the_mean_ratio() {
+    let s = Scratch::new("cli-compare", "meanratio");
+    s.render("ref.exr", 1.5, 64, 0);
+    let strip = |img: ExrImage| ExrImage {
+        channels: img
+            .channels
+            .into_iter()
+            .filter(|c| ["R", "G", "B"].contains(&&*c.name))
+            .collect(),
+        ..img
+    };
+    let reference = strip(exr(&s, "ref.exr"));
+    write_exr(&s.path("plain.exr"), &reference).unwrap();
+    write_exr(&s.path("bright.exr"), &brightened(reference, 1.01)).unwrap();
+    // relMSE of a 1 % gain is 1e-4, below its 1e-3 threshold; the mean ratio 1.01 is not.
+    let report = status(&s.compare("bright.exr", "plain.exr", &[]), 1);
+    assert!(
+        field(&report, "relMSE").parse::<f64>().unwrap() < 1e-3,
+        "{report}"
+    );
+    let mean = field(&report, "mean");
+    assert!(
+        mean.starts_with("test/reference R 1.0100  G 1.0100  B 1.0100 (tolerance ±0.5 %, FAIL)"),
+        "{report}"
+    );
+    assert!(
+        field(&report, "verdict").starts_with("FAIL (mean ratio R 1.0100 outside 1 ± 0.005"),
+        "{report}"
+    );
+    let report = status(
+        &s.compare("bright.exr", "plain.exr", &["--mean-tolerance", "0.02"]),
+        0,
+    );
+    assert!(
+        field(&report, "mean").ends_with("(tolerance ±2 %, pass)"),
+        "{report}"
+    );
+    for bad in ["1.5", "-0.01", "inf", "0.5%"] {
+        let out = s.compare(
+            "bright.exr",
+            "plain.exr",
+            &[&format!("--mean-tolerance={bad}")],
+        );
+        assert_eq!(status(&out, 2), "");
+        assert!(text(&out.stderr).contains("is not a fraction in [0, 1]"));
+    }
+}

@@ -3,13 +3,15 @@
 //! z-tested against its high-spp reference in `tests/refs/` (96×96, 2048 spp, Sobol', seed 1000;
 //! regenerate with `scripts/update-refs`) by `lapidary::image::compare`: per pixel and channel
 //! `z = (t − r)/√(var_t + var_r)`, α = 0.01 with Šidák correction over all pixel-channels, the
-//! image passing when ≥ 99.75 % of its pixels pass (Mitsuba's practice). The independent sampler
-//! keeps the test's sample variance an honest estimate of its error.
+//! image passing when ≥ 99.75 % of its pixels pass (Mitsuba's practice), and by the aggregate
+//! test of the mean difference over the whole image and 32², 16², 8² tiles (α = 0.01 shared by
+//! the scales). The independent sampler keeps the test's sample variance an honest estimate of
+//! its error.
 //!
 //! A failure writes the test render, the reference and a heatmap under `target/golden/` and names
 //! them in the message.
 
-use lapidary::image::compare::{Comparison, compare};
+use lapidary::image::compare::{Comparison, ZTest, compare};
 use lapidary::image::write_heatmap;
 use lapidary::image::{ExrImage, read_exr, write_exr};
 use lapidary::recipe::GemRecipe;
@@ -73,6 +75,18 @@ fn evidence(name: &str, test: &ExrImage, reference: &ExrImage, c: &Comparison) -
     )
 }
 
+/// The aggregate test's scales as `label |z|/limit`, failing ones marked.
+fn scales(z: &ZTest) -> String {
+    z.scales
+        .iter()
+        .map(|s| {
+            let mark = if s.passed { "" } else { " FAIL" };
+            format!("{} {:.2}/{:.2}{mark}", s.label(), s.max_abs_z, s.z_crit)
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
 fn references() -> Vec<(String, PathBuf)> {
     let mut refs: Vec<(String, PathBuf)> = std::fs::read_dir("tests/refs")
         .expect("tests/refs")
@@ -113,12 +127,14 @@ fn golden_renders_match_their_references() {
         let c = compare(&test, &reference).unwrap_or_else(|e| panic!("{name}: {e}"));
         let z = c.ztest.as_ref().expect("references carry variance");
         eprintln!(
-            "{name}: {:.2} % of pixels pass (max |z| {:.2}, limit {:.2}), relMSE {:.2e}, FLIP {:.4}",
+            "{name}: {:.2} % of pixels pass (max |z| {:.2}, limit {:.2}), relMSE {:.2e}, FLIP {:.4}; \
+             tiles |z|/limit: {}",
             100.0 * z.pass_fraction,
             z.max_abs_z,
             z.z_crit,
             c.rel_mse,
-            c.flip
+            c.flip,
+            scales(z)
         );
         if !c.passed {
             failures.push(evidence(name, &test, &reference, &c));

@@ -1,10 +1,13 @@
 //! `lapidary compare TEST.exr REF.exr [--heatmap diff.png]`: regression check of a render against
 //! a reference (DESIGN §8). Prints one line per metric and a verdict; the rules are those of
-//! [`mod@crate::image::compare`]. Exit status: 0 pass, 1 fail, 2 unusable input (a missing or
-//! unreadable file, sizes that differ, a missing colour channel) or an unwritable heatmap.
+//! [`mod@crate::image::compare`]: the per-pixel z-test, the aggregate test at each tile scale
+//! (one line per scale: tiles, largest |z|, limit, verdict) and the mean ratio. Exit status: 0
+//! pass, 1 fail, 2 unusable input (a missing or unreadable file, sizes that differ, a missing
+//! colour channel, a NaN, infinite or negative variance) or an unwritable heatmap.
 
 use crate::image::compare::{
-    CompareError, Comparison, REL_MSE_THRESHOLD, Role, TestVariance, compare,
+    AGGREGATE_ALPHA, CompareError, Comparison, MEAN_TOLERANCE, Options, REL_MSE_THRESHOLD, Rgb,
+    Role, TestVariance, ZTest, compare_with,
 };
 use crate::image::{read_exr, write_heatmap};
 use anyhow::{Result, anyhow};
@@ -22,6 +25,21 @@ pub struct CompareArgs {
     /// Write a false-colour error map (viridis PNG; yellow = failing, white = NaN/∞) here.
     #[arg(long, value_name = "PATH")]
     pub heatmap: Option<PathBuf>,
+    /// Largest |mean_t/mean_r − 1| of a channel that passes when the z-tests cannot run (no
+    /// variance): a fraction in [0, 1].
+    #[arg(long, value_name = "FRACTION", default_value_t = MEAN_TOLERANCE,
+          value_parser = parse_mean_tolerance)]
+    pub mean_tolerance: f64,
+}
+
+/// Parses `--mean-tolerance`: a fraction in `[0, 1]` (0.005 is 0.5 %).
+pub fn parse_mean_tolerance(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if (0.0..=1.0).contains(&v) => Ok(v),
+        _ => Err(format!(
+            "`{s}` is not a fraction in [0, 1] (e.g. 0.005 for 0.5 %)"
+        )),
+    }
 }
 
 /// The outcome of `lapidary compare`.
@@ -36,12 +54,24 @@ pub enum Verdict {
 /// Runs `lapidary compare`, printing the report on stdout. An error means unusable input (or an
 /// unwritable heatmap), for exit status 2; its message names the file.
 pub fn run(args: &CompareArgs) -> Result<Verdict> {
+    let heatmap = match &args.heatmap {
+        Some(path) => {
+            let mut plan = crate::image::outputs::OutputPlan::new();
+            plan.input(&args.test, "the test image")?;
+            plan.input(&args.reference, "the reference")?;
+            Some(plan.output(path, crate::image::outputs::Format::Png)?)
+        }
+        None => None,
+    };
     let test = read_exr(&args.test)?;
     let reference = read_exr(&args.reference)?;
-    let c = compare(&test, &reference).map_err(|e| describe(args, e))?;
+    let options = Options {
+        mean_tolerance: args.mean_tolerance,
+    };
+    let c = compare_with(&test, &reference, &options).map_err(|e| describe(args, e))?;
     out!("{}", report(&args.test, &args.reference, &c));
-    if let Some(path) = &args.heatmap {
-        write_heatmap(path, &c)?;
+    if let (Some(path), Some(file)) = (&args.heatmap, &heatmap) {
+        write_heatmap(file, &c)?;
         let top = match &c.ztest {
             Some(z) => format!("|z| ≥ {:.2}", z.z_crit),
             None => format!("relative error ≥ {}", c.error_scale),
@@ -89,6 +119,19 @@ fn describe(args: &CompareArgs, e: CompareError) -> anyhow::Error {
                 found.join(", ")
             }
         ),
+        CompareError::BadVariance {
+            which,
+            channel,
+            x,
+            y,
+            value,
+            count,
+        } => anyhow!(
+            "{}: `{channel}` is {value} at pixel ({x}, {y}) ({count} such values); a variance \
+             must be finite and ≥ 0, so the file's error estimate cannot be used",
+            path(which)
+        ),
+        e @ CompareError::BadTolerance(_) => e.into(),
         CompareError::Empty => anyhow!(
             "{} and {}: the images have no pixels",
             path(Role::Test),
@@ -142,31 +185,147 @@ fn report(test: &Path, reference: &Path, c: &Comparison) -> String {
                 out += "; test variance = reference's × n_ref/n_test";
             }
             out.push('\n');
+            let _ = writeln!(
+                out,
+                "  bias      mean difference per tile, α {} shared by {} scales (Šidák):",
+                AGGREGATE_ALPHA,
+                z.scales.len()
+            );
+            out += &scale_lines(z);
         }
         (None, why) => {
             let why = why.as_deref().unwrap_or("no variance");
             let _ = writeln!(
                 out,
-                "  z-test    skipped: {why}; verdict from relMSE ≤ {REL_MSE_THRESHOLD:e}"
+                "  z-test    skipped: {why}; verdict from relMSE ≤ {REL_MSE_THRESHOLD:e} and the \
+                 mean ratio"
             );
+        }
+    }
+    let m = &c.mean_ratio;
+    let _ = writeln!(
+        out,
+        "  mean      test/reference R {:.4}  G {:.4}  B {:.4} (tolerance ±{} %{})",
+        m.ratio[0],
+        m.ratio[1],
+        m.ratio[2],
+        100.0 * m.tolerance,
+        if c.ztest.is_some() {
+            ", not used: the z-tests ran"
+        } else if m.passed {
+            ", pass"
+        } else {
+            ", FAIL"
+        }
+    );
+    out
+}
+
+/// The aggregate test, one indented line per scale: tiles, largest |z|, limit and verdict (with
+/// the worst tile when it fails).
+pub fn scale_lines(z: &ZTest) -> String {
+    let mut out = String::new();
+    for s in &z.scales {
+        let tiles = format!("{} tile{}", s.tiles, if s.tiles == 1 { "" } else { "s" });
+        let _ = write!(
+            out,
+            "    {:<8} {tiles:>10}   |z| max {:>6.2}   limit {:.2}   ",
+            s.label(),
+            s.max_abs_z,
+            s.z_crit
+        );
+        match (&s.worst, s.passed) {
+            (Some(w), false) => {
+                let _ = writeln!(
+                    out,
+                    "FAIL ({} tile channel{}; worst {} of the {}x{} tile at ({}, {}), z {:+.2})",
+                    s.failed,
+                    if s.failed == 1 { "" } else { "s" },
+                    w.channel,
+                    w.width,
+                    w.height,
+                    w.x,
+                    w.y,
+                    w.z
+                );
+            }
+            _ => out += if s.passed { "pass\n" } else { "FAIL\n" },
         }
     }
     out
 }
 
-/// `PASS` or `FAIL (why)`.
-fn verdict_line(c: &Comparison) -> String {
+/// The aggregate test in one line: `label |z|/limit` per scale, failing scales marked.
+pub fn scale_summary(z: &ZTest) -> String {
+    z.scales
+        .iter()
+        .map(|s| {
+            format!(
+                "{} {:.2}/{:.2}{}",
+                s.label(),
+                s.max_abs_z,
+                s.z_crit,
+                if s.passed { "" } else { " FAIL" }
+            )
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// Why `c` failed, each failed part in a few words (empty if it passed).
+pub fn failure_reasons(c: &Comparison) -> Vec<String> {
+    let mut why = Vec::new();
     if c.passed {
-        return "PASS".into();
+        return why;
     }
     match &c.ztest {
-        Some(z) => format!(
-            "FAIL ({} of {} pixels fail the z-test)",
-            z.failed_pixels, z.pixels
-        ),
-        None if c.non_finite_pixels > 0 => {
-            format!("FAIL ({} pixels are NaN or ∞)", c.non_finite_pixels)
+        Some(z) => {
+            if !z.pixels_passed {
+                why.push(format!(
+                    "{} of {} pixels fail the z-test",
+                    z.failed_pixels, z.pixels
+                ));
+            }
+            for s in z.scales.iter().filter(|s| !s.passed) {
+                let mut line = format!(
+                    "bias at {}: |z| {:.2} > {:.2}",
+                    s.label(),
+                    s.max_abs_z,
+                    s.z_crit
+                );
+                if let Some(w) = &s.worst {
+                    let _ = write!(line, " in {} of the tile at ({}, {})", w.channel, w.x, w.y);
+                }
+                why.push(line);
+            }
         }
-        None => format!("FAIL (relMSE {:.3e} > {REL_MSE_THRESHOLD:e})", c.rel_mse),
+        None => {
+            if c.non_finite_pixels > 0 {
+                why.push(format!("{} pixels are NaN or ∞", c.non_finite_pixels));
+            }
+            if !(c.rel_mse <= REL_MSE_THRESHOLD) {
+                why.push(format!("relMSE {:.3e} > {REL_MSE_THRESHOLD:e}", c.rel_mse));
+            }
+            let m = &c.mean_ratio;
+            for (k, q) in m.ratio.iter().enumerate() {
+                if !((q - 1.0).abs() <= m.tolerance) {
+                    why.push(format!(
+                        "mean ratio {} {q:.4} outside 1 ± {}",
+                        Rgb::ALL[k],
+                        m.tolerance
+                    ));
+                }
+            }
+        }
+    }
+    why
+}
+
+/// `PASS` or `FAIL (why; why…)`.
+fn verdict_line(c: &Comparison) -> String {
+    if c.passed {
+        "PASS".into()
+    } else {
+        format!("FAIL ({})", failure_reasons(c).join("; "))
     }
 }
