@@ -336,6 +336,9 @@ fn degenerate_environment_maps_are_refused_or_warned_about() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("pixel (1, 1) is infinite"), "{e}");
+    write_map(&s.path("huge.exr"), |i| if i == 10 { 1e30 } else { 1.0 });
+    let e = EnvironmentLight::new(&map("huge.exr")).unwrap_err().to_string();
+    assert!(e.contains("pixel (2, 1)") && e.contains("up to 1e12"), "{e}");
     write_map(&s.path("zero.exr"), |_| 0.0);
     let zero = EnvironmentLight::new(&map("zero.exr")).unwrap();
     assert!(

@@ -77,8 +77,13 @@ pub struct EnvironmentLight {
     invalid_pixels: usize,
 }
 
-/// Refuses a map no light can be made of: an infinite pixel (its radiance, and the sampling
-/// weight of every other pixel beside it, would be meaningless) or every pixel NaN.
+/// Largest value of a map pixel's channel: far above any real sky or sun stored relative to the
+/// scene, and low enough that the sampling sums over the largest map (2²⁷ pixels, times an
+/// `intensity` of up to 1e6) stay finite in `f32`.
+pub const MAX_MAP_VALUE: f32 = 1e12;
+
+/// Refuses a map no light can be made of: an infinite or absurd pixel (its radiance, and the
+/// sampling weight of every other pixel beside it, would be meaningless) or every pixel NaN.
 fn refuse_unusable(path: &std::path::Path, img: &RgbImage) -> Result<(), ImageError> {
     let invalid = |reason: String| ImageError::Invalid {
         path: path.into(),
@@ -91,6 +96,15 @@ fn refuse_unusable(path: &std::path::Path, img: &RgbImage) -> Result<(), ImageEr
             "pixel ({}, {}) is infinite: an environment map must hold finite radiance",
             i % w,
             i / w
+        )));
+    }
+    let absurd = |p: &[f32; 3]| p.iter().any(|&c| c > MAX_MAP_VALUE);
+    if let Some(i) = img.pixels.iter().position(absurd) {
+        return Err(invalid(format!(
+            "pixel ({}, {}) = {:?} is out of range: each channel allowed up to {MAX_MAP_VALUE:e}",
+            i % w,
+            i / w,
+            img.pixels[i]
         )));
     }
     if !img.pixels.is_empty() && img.pixels.iter().all(|p| p.iter().any(|c| c.is_nan())) {
