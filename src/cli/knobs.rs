@@ -88,6 +88,47 @@ fn effect_arg(s: &str) -> Result<(Effect, bool), String> {
     Ok((e, switch_arg(value.trim())?))
 }
 
+/// Which knob a setting's key names: `model`, `fresnel`, `sampler`, `max-depth` (also written
+/// `max_depth`) or an effect (under any of its names); `None` for an unknown key, which the
+/// setting's parser reports.
+fn knob_of(key: &str) -> Option<String> {
+    match key {
+        "model" | "fresnel" | "sampler" => Some(key.into()),
+        "max-depth" | "max_depth" => Some("max-depth".into()),
+        _ => effect_named(key).map(|e| e.name().to_string()),
+    }
+}
+
+/// Checks the form of a `tradeoff --setting` before anything renders: not empty (the recipe as
+/// written is `baseline`), no empty item between commas, and no knob named twice (such as
+/// `model=course,model=reference`, or `bump=off,facet-bump=on`, two names of one knob). The
+/// values are checked by the setting's parser.
+pub fn check_setting(setting: &str) -> Result<(), String> {
+    if setting.trim().is_empty() {
+        return Err(
+            "an empty setting; write `baseline` for the recipe as written, or \
+                    key=value,… (e.g. model=course,fresnel=table)"
+                .into(),
+        );
+    }
+    let mut seen: Vec<(String, &str)> = vec![];
+    for part in setting.split(',').map(str::trim) {
+        if part.is_empty() {
+            return Err("an empty item between commas; write key=value,key=value".into());
+        }
+        let key = part.split_once('=').map_or(part, |(k, _)| k).trim();
+        let Some(knob) = knob_of(key) else { continue };
+        if let Some((_, first)) = seen.iter().find(|(k, _)| *k == knob) {
+            return Err(format!(
+                "names the knob `{knob}` twice (`{first}` and `{part}`); give each knob once, \
+                 or use two --setting options to compare the values"
+            ));
+        }
+        seen.push((knob, part));
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -111,5 +152,33 @@ mod tests {
                 .contains("NAME=on|off")
         );
         assert!(switch_arg("maybe").unwrap_err().contains("on, off"));
+    }
+
+    #[test]
+    fn settings_are_checked_for_form() {
+        for ok in [
+            "baseline",
+            "model=course",
+            "model=course, fresnel=table",
+            "max-depth=4",
+        ] {
+            assert_eq!(check_setting(ok), Ok(()), "{ok}");
+        }
+        assert!(check_setting("").unwrap_err().contains("empty setting"));
+        assert!(check_setting("  ").unwrap_err().contains("empty setting"));
+        assert!(
+            check_setting("model=course,")
+                .unwrap_err()
+                .contains("empty item")
+        );
+        let e = check_setting("model=course,model=reference").unwrap_err();
+        assert!(
+            e.contains("`model` twice") && e.contains("model=reference"),
+            "{e}"
+        );
+        let e = check_setting("max_depth=2,max-depth=4").unwrap_err();
+        assert!(e.contains("`max-depth` twice"), "{e}");
+        let e = check_setting("bump=off,facet-bump=on").unwrap_err();
+        assert!(e.contains("twice"), "{e}");
     }
 }

@@ -5,6 +5,7 @@
 //! random number from `(seed, pixel)`.
 
 use crate::bsdf::{Base, ConductorIor, StackDesc};
+use crate::image::outputs::{Format, OutputPlan};
 use crate::recipe::GemRecipe;
 use crate::sampler::{hash_words, to_unit_f32};
 use crate::texture::MapHit;
@@ -67,7 +68,8 @@ fn parse_extent(s: &str) -> Result<f32, String> {
 pub struct MapArgs {
     /// Gem recipe (RON).
     pub recipe: PathBuf,
-    /// Output PNG (written atomically: a failed run leaves an existing file untouched).
+    /// Output PNG (checked before drawing, see `docs/rendering.md`; written atomically: a failed
+    /// run leaves an existing file untouched).
     #[arg(long, short)]
     pub out: PathBuf,
     /// Side of the square map in pixels.
@@ -151,7 +153,13 @@ pub fn palette(i: usize) -> [u8; 3] {
 
 /// Runs `lapidary map`.
 pub fn run(args: &MapArgs) -> Result<()> {
+    let mut plan = OutputPlan::new();
+    plan.input(&args.recipe, "the recipe")?;
+    let out_file = plan.output(&args.out, Format::Png)?;
     let recipe = GemRecipe::load(&args.recipe).map_err(|e| anyhow!("{e}"))?;
+    for (path, role) in super::render::recipe_inputs(&recipe) {
+        plan.input(&path, role)?;
+    }
     let surface = recipe.compile().map_err(|e| anyhow!("{e}"))?.surface;
     for name in surface.unused() {
         eprintln!("warning: material \"{name}\" is never used by the surface map");
@@ -220,7 +228,7 @@ pub fn run(args: &MapArgs) -> Result<()> {
     }
     let img = image::RgbImage::from_raw(w as u32, h as u32, buf)
         .ok_or_else(|| anyhow!("map: buffer size"))?;
-    super::write_atomically(&args.out, |tmp| {
+    super::write_atomically(&out_file, |tmp| {
         img.save_with_format(tmp, image::ImageFormat::Png)
             .map_err(|e| anyhow!("{}: {e}", args.out.display()))
     })?;

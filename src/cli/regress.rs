@@ -121,12 +121,42 @@ fn row(name: &str, c: &Comparison, spp: u32, secs: f64) -> String {
     )
 }
 
+/// The files a run may write, per recipe: its reference (`--update`), or a failed test's EXR and
+/// heatmap in `--out`; each checked ([`crate::image::outputs`]) before the first render.
+fn planned_outputs(args: &RegressArgs, list: &[PathBuf]) -> Result<Vec<Vec<PathBuf>>> {
+    use crate::image::outputs::{Format, OutputPlan};
+    let mut plan = OutputPlan::new();
+    for recipe in list {
+        plan.input(recipe, "the recipe")?;
+    }
+    if args.update {
+        return list
+            .iter()
+            .map(|r| Ok(vec![plan.output(&r.with_extension("exr"), Format::Exr)?]))
+            .collect();
+    }
+    for recipe in list {
+        plan.input(&recipe.with_extension("exr"), "the reference")?;
+    }
+    plan.folder(&args.out)?;
+    list.iter()
+        .map(|r| {
+            let name = r.file_stem().unwrap_or_default().to_string_lossy();
+            Ok(vec![
+                plan.output_in(&args.out, &format!("{name}-test.exr"), Format::Exr)?,
+                plan.output_in(&args.out, &format!("{name}-heatmap.png"), Format::Png)?,
+            ])
+        })
+        .collect()
+}
+
 /// Runs `lapidary regress`.
 pub fn run(args: &RegressArgs) -> Result<Outcome> {
     let list = recipes(&args.dir)?;
+    let files = planned_outputs(args, &list)?;
     let mut outcome = Outcome::Pass;
     if args.update {
-        for recipe in &list {
+        for (recipe, file) in list.iter().zip(&files) {
             let img = render_recipe(
                 recipe,
                 args.size,
@@ -136,7 +166,7 @@ pub fn run(args: &RegressArgs) -> Result<Outcome> {
                 args.threads,
             )?;
             let out = recipe.with_extension("exr");
-            write_exr(&out, &img)?;
+            write_exr(&file[0], &img)?;
             outln!(
                 "{}: reference written ({} spp)",
                 out.display(),
@@ -156,7 +186,7 @@ pub fn run(args: &RegressArgs) -> Result<Outcome> {
         "PSNR dB",
         "time"
     );
-    for recipe in &list {
+    for (recipe, file) in list.iter().zip(&files) {
         let name = recipe
             .file_stem()
             .unwrap_or_default()
@@ -202,8 +232,11 @@ pub fn run(args: &RegressArgs) -> Result<Outcome> {
                 .map_err(|e| anyhow!("{}: {e}", args.out.display()))?;
             let t = args.out.join(format!("{name}-test.exr"));
             let h = args.out.join(format!("{name}-heatmap.png"));
-            write_exr(&t, &test)?;
-            write_heatmap(&h, &c)?;
+            // Both or neither, to the paths checked before the first render.
+            crate::image::atomic::all_or_nothing(|| {
+                write_exr(&file[0], &test)?;
+                Ok(write_heatmap(&file[1], &c)?)
+            })?;
             outln!("    wrote {} and {}", t.display(), h.display());
             if outcome == Outcome::Pass {
                 outcome = Outcome::Fail;

@@ -1,9 +1,15 @@
 //! `lapidary render RECIPE`: path-trace a gem recipe to an EXR (colour, AOVs, metadata) and a
-//! tone-mapped PNG, with a progress bar and a closing summary. Ctrl-C or `--time-limit` stop the
-//! render cleanly and write what was accumulated, marked partial in the EXR's metadata.
+//! tone-mapped PNG, with a progress bar and a closing summary. Ctrl-C, SIGTERM or `--time-limit`
+//! stop the render cleanly and write what was accumulated, marked partial in the EXR's metadata;
+//! stopped before the first pass over the image completed, they write nothing. A second Ctrl-C
+//! or SIGTERM aborts at once (exit 130) without writing. Outputs are checked before any work
+//! ([`crate::image::outputs`]) and written all or nothing.
 
+use crate::image::atomic::{abort_process, all_or_nothing};
+use crate::image::outputs::{Format, OutputPlan};
 use crate::image::{Curve, ToneMap, write_exr, write_png};
 use crate::recipe::GemRecipe;
+use crate::recipe::stage::{EnvironmentDesc, ShapeDesc};
 use crate::render::{Control, Metadata, Rendered, Strategy, World, exr_image, render_scene};
 use crate::scene::stage::SamplerKind;
 use crate::scene::{Effect, Scene};
@@ -123,15 +129,43 @@ fn parse_exposure(s: &str) -> Result<f32, String> {
     }
 }
 
-/// The Ctrl-C flag, installed once per process.
-fn interrupted() -> &'static AtomicBool {
+/// The Ctrl-C / SIGTERM flag, installed once per process. The first signal sets it; the second
+/// removes this process's temporary files and exits with 130 at once.
+pub(crate) fn interrupted() -> &'static AtomicBool {
     static FLAG: OnceLock<&'static AtomicBool> = OnceLock::new();
     FLAG.get_or_init(|| {
         let flag: &'static AtomicBool = Box::leak(Box::new(AtomicBool::new(false)));
         // If a handler cannot be installed, Ctrl-C simply kills the process as usual.
-        let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
+        let _ = ctrlc::set_handler(move || {
+            if flag.swap(true, Ordering::SeqCst) {
+                eprintln!("second interrupt: aborted, nothing written");
+                abort_process(130);
+            }
+        });
         flag
     })
+}
+
+/// The files a loaded recipe reads besides itself: included libraries, the mesh, the
+/// environment map (so that none of them can be an output).
+pub(crate) fn recipe_inputs(recipe: &GemRecipe) -> Vec<(PathBuf, &'static str)> {
+    let mut inputs: Vec<(PathBuf, &'static str)> = recipe
+        .library
+        .sources()
+        .iter()
+        .skip(1)
+        .map(|s| (PathBuf::from(&s.file), "the included library"))
+        .collect();
+    let base = recipe.base_dir();
+    if let Some(stage) = &recipe.content.stage {
+        if let Some(ShapeDesc::Mesh { file, .. }) = &stage.shape {
+            inputs.push((base.join(file), "the mesh"));
+        }
+        if let Some(EnvironmentDesc::Map { file, .. }) = &stage.environment {
+            inputs.push((base.join(file), "the environment map"));
+        }
+    }
+    inputs
 }
 
 /// Where the EXR and PNG go.
@@ -155,14 +189,6 @@ fn outputs(args: &RenderArgs) -> Result<(PathBuf, Option<PathBuf>)> {
                 .unwrap_or_else(|| exr.with_extension("png")),
         )
     };
-    for p in std::iter::once(&exr).chain(png.iter()) {
-        let dir = p.parent().filter(|d| !d.as_os_str().is_empty());
-        if let Some(d) = dir
-            && !d.is_dir()
-        {
-            bail!("{}: directory {} does not exist", p.display(), d.display());
-        }
-    }
     Ok((exr, png))
 }
 
@@ -193,10 +219,24 @@ fn settings(args: &RenderArgs, scene: &mut Scene) {
     }
 }
 
-/// Runs `lapidary render`; returns whether the render was interrupted by Ctrl-C.
+/// Runs `lapidary render`; returns whether the render was interrupted by Ctrl-C or SIGTERM
+/// (exit 130). A render stopped by `--time-limit` before its first pass is an error (exit 1).
 pub fn run(args: &RenderArgs) -> Result<bool> {
+    // Installed first, so that a signal during setup also stops cleanly.
+    let cancel = interrupted();
+    cancel.store(false, Ordering::SeqCst);
     let (exr_path, png_path) = outputs(args)?;
+    let mut plan = OutputPlan::new();
+    plan.input(&args.recipe, "the recipe")?;
+    let exr_file = plan.output(&exr_path, Format::Exr)?;
+    let png_file = match &png_path {
+        Some(p) => Some(plan.output(p, Format::Png)?),
+        None => None,
+    };
     let recipe = GemRecipe::load(&args.recipe).map_err(|e| anyhow!("{e}"))?;
+    for (path, role) in recipe_inputs(&recipe) {
+        plan.input(&path, role)?;
+    }
     let mut scene = recipe.compile().map_err(|e| anyhow!("{e}"))?;
     settings(args, &mut scene);
     args.knobs
@@ -222,8 +262,6 @@ pub fn run(args: &RenderArgs) -> Result<bool> {
         .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let progress = |n: u64| bar.inc(n);
-    let cancel = interrupted();
-    cancel.store(false, Ordering::SeqCst);
     let control = Control {
         threads: args.threads.map(|t| t as usize),
         strategy: match args.strategy {
@@ -241,21 +279,40 @@ pub fn run(args: &RenderArgs) -> Result<bool> {
     let rendered = render_scene(&world, &scene, &control);
     bar.finish_and_clear();
     let was_interrupted = cancel.load(Ordering::SeqCst);
+    if rendered.stats.spp_complete == 0 {
+        // Not one complete pass: some pixels would have no sample at all.
+        if was_interrupted {
+            eprintln!(
+                "stopped by Ctrl-C or SIGTERM before the first pass over the image completed: \
+                 nothing written"
+            );
+            return Ok(true);
+        }
+        bail!(
+            "--time-limit {} s ended before the first pass over the image completed: nothing \
+             written (allow more time, or render fewer pixels)",
+            args.time_limit.unwrap_or_default()
+        );
+    }
 
     let meta = Metadata::of(&args.recipe.display().to_string(), &scene);
-    write_exr(&exr_path, &exr_image(&rendered, &meta))
-        .with_context(|| format!("writing {}", exr_path.display()))?;
-    if let Some(png) = &png_path {
-        let tm = ToneMap {
-            exposure: r.exposure,
-            curve: match args.tonemap {
-                CurveArg::Filmic => Curve::Filmic,
-                CurveArg::Clamp => Curve::Clamp,
-            },
-        };
-        write_png(png, r.width, r.height, &rendered.film.rgb(), &tm)
-            .with_context(|| format!("writing {}", png.display()))?;
-    }
+    // Both files or neither: a PNG that cannot be written leaves the old EXR in place.
+    all_or_nothing(|| {
+        write_exr(&exr_file, &exr_image(&rendered, &meta))
+            .with_context(|| format!("writing {}", exr_path.display()))?;
+        if let (Some(png), Some(shown)) = (&png_file, &png_path) {
+            let tm = ToneMap {
+                exposure: r.exposure,
+                curve: match args.tonemap {
+                    CurveArg::Filmic => Curve::Filmic,
+                    CurveArg::Clamp => Curve::Clamp,
+                },
+            };
+            write_png(png, r.width, r.height, &rendered.film.rgb(), &tm)
+                .with_context(|| format!("writing {}", shown.display()))?;
+        }
+        Ok(())
+    })?;
     if !args.quiet {
         out!(
             "{}",
@@ -308,7 +365,11 @@ fn summary(
         secs
     );
     if s.partial {
-        let why = if interrupted { "Ctrl-C" } else { "time limit" };
+        let why = if interrupted {
+            "Ctrl-C or SIGTERM"
+        } else {
+            "time limit"
+        };
         out += &format!(
             "  stopped by {why}: partial, {} of {} spp in every pixel (the EXR says so)\n",
             s.spp_complete, set.spp

@@ -9,6 +9,8 @@
 
 use super::knobs::KnobArgs;
 use super::render::parse_size;
+use crate::image::atomic::all_or_nothing;
+use crate::image::outputs::{Format, OutputPlan};
 use crate::image::{read_exr, write_exr};
 use crate::recipe::GemRecipe;
 use crate::render::study::{Convergence, Errors, Reference, converge};
@@ -143,9 +145,18 @@ pub fn run(args: &TradeoffArgs) -> Result<()> {
     };
     let settings: Vec<Knobs> = labels
         .iter()
-        .map(|l| l.parse().map_err(|e| anyhow!("--setting `{l}`: {e}")))
+        .map(|l| {
+            super::knobs::check_setting(l).map_err(|e| anyhow!("--setting `{l}`: {e}"))?;
+            l.parse().map_err(|e| anyhow!("--setting `{l}`: {e}"))
+        })
         .collect::<Result<_>>()?;
+    let mut plan = OutputPlan::new();
+    plan.input(&args.recipe, "the recipe")?;
+    plan.folder(&args.out)?;
     let recipe = GemRecipe::load(&args.recipe).map_err(|e| anyhow!("{e}"))?;
+    for (path, role) in super::render::recipe_inputs(&recipe) {
+        plan.input(&path, role)?;
+    }
     let mut base = recipe.compile().map_err(|e| anyhow!("{e}"))?;
     let (w, h) = args.size;
     base.stage.render.width = w;
@@ -159,15 +170,21 @@ pub fn run(args: &TradeoffArgs) -> Result<()> {
         k.apply(&mut base.clone(), "tradeoff")
             .map_err(|e| anyhow!("--setting `{l}`: {e}"))?;
     }
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("creating {}", args.out.display()))?;
     let name = args
         .recipe
         .file_stem()
         .map_or("recipe".into(), |s| s.to_string_lossy().to_string());
+    let (ref_scene, ref_name) = reference_scene(args, &base, &name)?;
+    // Every output is checked before the first render.
+    let ref_path = plan.output_in(&args.out, &ref_name, Format::Exr)?;
+    let csv_path = plan.output_in(&args.out, "tradeoff.csv", Format::Csv)?;
+    let curves_path = plan.output_in(&args.out, "tradeoff-curves.csv", Format::Csv)?;
+    let plot = plan.output_in(&args.out, "tradeoff.png", Format::Png)?;
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("creating {}", args.out.display()))?;
     let threads = args.threads.map(|t| t as usize);
 
-    let reference = reference(args, &base, &name, threads)?;
+    let reference = reference(args, ref_scene, &ref_path, threads)?;
     let budget = Duration::from_secs_f64(args.budget);
     // Warm up (thread pool, caches, clock frequency) on the baseline, so the first setting is not
     // timed cold: unwarmed, it ran about 10 % slower than the same work later in the run.
@@ -200,10 +217,12 @@ pub fn run(args: &TradeoffArgs) -> Result<()> {
     }
     let table = table(args, &rows, &reference);
     out!("{table}");
-    write_csv(&args.out.join("tradeoff.csv"), &summary_csv(args, &rows))?;
-    write_csv(&args.out.join("tradeoff-curves.csv"), &curves_csv(&rows))?;
-    let plot = args.out.join("tradeoff.png");
-    super::tradeoff_plot::plot(&name, &rows, reference.noise_floor(), &plot)?;
+    // The three files together or none of them.
+    all_or_nothing(|| {
+        write_csv(&csv_path, &summary_csv(args, &rows))?;
+        write_csv(&curves_path, &curves_csv(&rows))?;
+        super::tradeoff_plot::plot(&name, &rows, reference.noise_floor(), &plot)
+    })?;
     outln!(
         "wrote {}, {}, {}",
         args.out.join("tradeoff.csv").display(),
@@ -227,14 +246,10 @@ fn spinner(quiet: bool, msg: String) -> ProgressBar {
     s
 }
 
-/// Loads the cached reference or renders it (Reference model, exact Fresnel, `--ref-depth`,
-/// `--ref-spp`, independent sampler, a seed unrelated to the settings').
-fn reference(
-    args: &TradeoffArgs,
-    base: &Scene,
-    name: &str,
-    threads: Option<usize>,
-) -> Result<Reference> {
+/// The reference's scene (Reference model, exact Fresnel, `--ref-depth`, `--ref-spp`,
+/// independent sampler, a seed unrelated to the settings') and its cache file's name, a hash of
+/// everything it depends on.
+fn reference_scene(args: &TradeoffArgs, base: &Scene, name: &str) -> Result<(Scene, String)> {
     let mut scene = base.clone();
     let knobs: Knobs = "model=reference,fresnel=exact".parse()?;
     knobs.apply(&mut scene, "tradeoff reference")?;
@@ -267,8 +282,18 @@ fn reference(
                 .collect::<Vec<_>>(),
         ),
     ]);
-    let path = args.out.join(format!("{name}-reference-{key:016x}.exr"));
-    if let Ok(img) = read_exr(&path)
+    Ok((scene, format!("{name}-reference-{key:016x}.exr")))
+}
+
+/// Loads the cached reference at `path` or renders `scene` and writes it there.
+fn reference(
+    args: &TradeoffArgs,
+    scene: Scene,
+    path: &Path,
+    threads: Option<usize>,
+) -> Result<Reference> {
+    let r = &scene.stage.render;
+    if let Ok(img) = read_exr(path)
         && let Ok(reference) = Reference::from_exr(&img)
         && (img.width, img.height) == (r.width, r.height)
     {
@@ -293,7 +318,7 @@ fn reference(
     spinner.finish_and_clear();
     let meta = Metadata::of(&args.recipe.display().to_string(), &scene);
     let img = exr_image(&rendered, &meta);
-    write_exr(&path, &img).with_context(|| format!("writing {}", path.display()))?;
+    write_exr(path, &img).with_context(|| format!("writing {}", path.display()))?;
     if !args.quiet {
         eprintln!(
             "reference: {} ({:.1} s)",

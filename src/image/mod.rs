@@ -27,6 +27,7 @@ pub mod exr;
 pub mod flip;
 pub mod heatmap;
 pub mod input_kind;
+pub mod outputs;
 pub mod png;
 pub mod stats;
 
