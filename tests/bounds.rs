@@ -93,3 +93,63 @@ fn a_hundred_thousand_unknown_names_are_each_reported() {
     let last = errors.last().unwrap();
     assert!(last.contains("\"x99999\""), "{last}");
 }
+
+/// An 8192 × 4096 environment map (33.5 M texels, one bright patch): its sampling tables take at
+/// most half of the image's own `f32` RGB size (they took 8 bytes a texel, f32 weights and CDF,
+/// plus a grid-sized copy of the weights while building), and what it samples has exactly the
+/// density it reports, down to the smallest texels.
+#[test]
+fn a_large_environment_map_keeps_its_tables_small() {
+    use lapidary::image::exr::RgbImage;
+    use lapidary::light::EnvironmentLight;
+    let (w, h) = (8192u32, 4096u32);
+    let mut pixels = vec![[0.25f32, 0.5, 0.75]; (w * h) as usize];
+    for y in 1000..1040 {
+        for x in 3000..3040 {
+            pixels[(y * w + x) as usize] = [5e3; 3];
+        }
+    }
+    // A dim corner far below the f32 resolution of its row's CDF.
+    pixels[(h as usize - 1) * w as usize] = [1e-12; 3];
+    let image_bytes = pixels.len() * 12;
+    let light = EnvironmentLight::from_rgb(
+        RgbImage {
+            width: w,
+            height: h,
+            pixels,
+        },
+        1.0,
+        0.0,
+    );
+    let tables = light.table_bytes();
+    println!(
+        "{w}x{h} map: tables {tables} bytes = {:.2} bytes per texel; image {image_bytes} bytes",
+        tables as f64 / f64::from(w * h)
+    );
+    assert!(
+        tables > 0 && tables * 2 <= image_bytes,
+        "{tables} > {image_bytes}/2"
+    );
+    let (mut hits, mut sampled) = (0, 0);
+    for i in 0..2000u32 {
+        let u = glam::Vec2::new(
+            (i as f32 + 0.5) / 2000.0,
+            ((i * 7919) % 2000) as f32 / 2000.0,
+        );
+        // (A sample exactly at a pole has an infinite density and is refused.)
+        let Some(s) = light.sample(u) else {
+            continue;
+        };
+        sampled += 1;
+        let pdf = light.pdf(s.wi);
+        assert!(
+            (pdf - s.pdf).abs() <= 1e-3 * s.pdf,
+            "sample pdf {} but pdf() {pdf}",
+            s.pdf
+        );
+        hits += usize::from(s.radiance.0[0] > 1e3);
+    }
+    assert!(sampled > 1990, "{sampled}");
+    // The patch holds most of the light (~ 1600 · 5e3 against 33.5 M · 0.5).
+    assert!(hits > 500, "{hits} of 2000 samples on the bright patch");
+}

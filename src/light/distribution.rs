@@ -23,48 +23,51 @@ pub struct Sample1D {
 }
 
 /// A piecewise-constant density on `[0, 1)` with `n` equal bins, proportional to the weights.
+///
+/// Only the cumulative table is kept (one `f32` per bin, plus one): a bin's probability is the
+/// difference of two neighbouring entries, and both [`sample`](Self::sample) and
+/// [`pdf`](Self::pdf) use that difference, so the density reported is exactly the one sampled (a
+/// bin far below the `f32` resolution of its row's total gets width 0: it is never chosen and its
+/// density is 0).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Distribution1D {
-    /// Sanitised weights (≥ 0, finite).
-    func: Vec<f32>,
-    /// `cdf[i]` = probability of bins `0 … i−1`; `cdf[n] = 1`. Length `n + 1`.
+    /// `cdf[i]` = probability of bins `0 … i−1`; `cdf[n] = 1`. Length `n + 1` (all 0 when black).
     cdf: Vec<f32>,
     /// `∫₀¹ f(x) dx` = mean weight; 0 when black.
     integral: f32,
+}
+
+/// A weight as the distributions count it: negative or non-finite weights are 0.
+fn sanitised(w: f32) -> f32 {
+    if w.is_finite() && w > 0.0 { w } else { 0.0 }
 }
 
 impl Distribution1D {
     /// A distribution over `weights.len()` bins; negative or non-finite weights count as 0. An empty
     /// or all-zero input gives a black distribution.
     pub fn new(weights: &[f32]) -> Distribution1D {
-        let func: Vec<f32> = weights
-            .iter()
-            .map(|&w| if w.is_finite() && w > 0.0 { w } else { 0.0 })
-            .collect();
-        let n = func.len();
-        // Accumulate in f64 so long rows of an environment map keep their small bins.
-        let mut running = 0.0f64;
-        let mut sums = Vec::with_capacity(n + 1);
-        sums.push(0.0f64);
-        for &f in &func {
-            running += f64::from(f);
-            sums.push(running);
-        }
-        let total = running;
-        let cdf = if total > 0.0 {
-            let mut c: Vec<f32> = sums.iter().map(|&s| (s / total) as f32).collect();
-            c[n] = 1.0;
-            c
+        let n = weights.len();
+        // Accumulate in f64 so long rows of an environment map keep their small bins; the total
+        // first, then the normalised running sums straight into the table (no other copy).
+        let total: f64 = weights.iter().map(|&w| f64::from(sanitised(w))).sum();
+        let mut cdf = Vec::with_capacity(n + 1);
+        if total > 0.0 && total.is_finite() {
+            let mut running = 0.0f64;
+            cdf.push(0.0);
+            for &w in weights {
+                running += f64::from(sanitised(w));
+                cdf.push((running / total) as f32);
+            }
+            cdf[n] = 1.0;
         } else {
-            vec![0.0; n + 1]
-        };
-        let integral = if n > 0 {
+            cdf.resize(n + 1, 0.0);
+        }
+        let integral = if n > 0 && total.is_finite() {
             (total / n as f64) as f32
         } else {
             0.0
         };
         Distribution1D {
-            func,
             cdf,
             integral: if integral.is_finite() { integral } else { 0.0 },
         }
@@ -72,12 +75,12 @@ impl Distribution1D {
 
     /// Number of bins.
     pub fn len(&self) -> usize {
-        self.func.len()
+        self.cdf.len() - 1
     }
 
     /// True when there are no bins.
     pub fn is_empty(&self) -> bool {
-        self.func.is_empty()
+        self.len() == 0
     }
 
     /// True when every weight is zero: nothing can be sampled.
@@ -90,17 +93,29 @@ impl Distribution1D {
         self.integral
     }
 
-    /// The sanitised weight of bin `i` (0 outside the range).
+    /// Bytes of heap the table takes.
+    pub fn heap_bytes(&self) -> usize {
+        self.cdf.capacity() * std::mem::size_of::<f32>()
+    }
+
+    /// The width of bin `i` in the cumulative table: its probability (0 outside the range or when
+    /// black).
+    fn width(&self, i: usize) -> f32 {
+        if self.is_black() || i >= self.len() {
+            return 0.0;
+        }
+        (self.cdf[i + 1] - self.cdf[i]).max(0.0)
+    }
+
+    /// The weight of bin `i` as the table represents it (its probability × n × mean weight; 0
+    /// outside the range).
     pub fn weight(&self, i: usize) -> f32 {
-        self.func.get(i).copied().unwrap_or(0.0)
+        self.width(i) * self.len() as f32 * self.integral
     }
 
     /// Probability of choosing bin `i` (discrete, sums to 1 unless black).
     pub fn bin_probability(&self, i: usize) -> f32 {
-        if self.is_black() || i >= self.len() {
-            return 0.0;
-        }
-        self.func[i] / (self.integral * self.len() as f32)
+        self.width(i)
     }
 
     /// Inverts the cumulative distribution at `u ∈ [0, 1)` (values outside are clamped): a point
@@ -121,7 +136,7 @@ impl Distribution1D {
         };
         let n = self.len() as f32;
         let x = ((index as f32 + du) / n).min(ONE_MINUS_EPSILON);
-        let pdf = self.func[index] / self.integral;
+        let pdf = (hi - lo) * n;
         (pdf > 0.0 && pdf.is_finite()).then_some(Sample1D { x, pdf, index })
     }
 
@@ -140,7 +155,7 @@ impl Distribution1D {
         if self.is_black() || !(0.0..1.0).contains(&x) {
             return 0.0;
         }
-        self.func[self.bin_of(x)] / self.integral
+        self.width(self.bin_of(x)) * self.len() as f32
     }
 }
 
@@ -173,17 +188,47 @@ impl Distribution2D {
     /// * `width`, `height` – the grid's columns and rows (a zero size gives a black distribution).
     /// * `weights` – `width · height` non-negative weights; others count as zero.
     pub fn new(width: usize, height: usize, weights: &[f32]) -> Distribution2D {
+        Self::from_rows(width, height, |r, row| {
+            let start = (r * width).min(weights.len());
+            let end = ((r + 1) * width).min(weights.len());
+            row.extend_from_slice(&weights[start..end]);
+        })
+    }
+
+    /// A distribution over a `width × height` grid whose row `r` of weights `row_weights(r, buf)`
+    /// appends to an empty `buf` (a short row is padded with zeros, a long one cut). Rows are
+    /// built in parallel, each from a buffer of one row, so no grid-sized copy of the weights is
+    /// ever made: the tables take [`heap_bytes`](Self::heap_bytes), about 4 bytes per cell.
+    pub fn from_rows(
+        width: usize,
+        height: usize,
+        row_weights: impl Fn(usize, &mut Vec<f32>) + Sync,
+    ) -> Distribution2D {
+        use rayon::prelude::*;
         let rows: Vec<Distribution1D> = (0..height)
-            .map(|r| {
-                let start = (r * width).min(weights.len());
-                let end = ((r + 1) * width).min(weights.len());
-                let mut row = weights[start..end].to_vec();
-                row.resize(width, 0.0);
-                Distribution1D::new(&row)
-            })
+            .into_par_iter()
+            .map_init(
+                || Vec::with_capacity(width),
+                |buf, r| {
+                    buf.clear();
+                    row_weights(r, buf);
+                    buf.resize(width, 0.0);
+                    Distribution1D::new(buf)
+                },
+            )
             .collect();
         let marginal = Distribution1D::new(&rows.iter().map(|d| d.integral()).collect::<Vec<_>>());
         Distribution2D { rows, marginal }
+    }
+
+    /// Bytes of heap the tables take (rows, their headers and the marginal).
+    pub fn heap_bytes(&self) -> usize {
+        self.rows
+            .iter()
+            .map(Distribution1D::heap_bytes)
+            .sum::<usize>()
+            + self.rows.capacity() * std::mem::size_of::<Distribution1D>()
+            + self.marginal.heap_bytes()
     }
 
     /// Number of columns.
@@ -232,9 +277,7 @@ impl Distribution2D {
         if self.is_black() || !(0.0..1.0).contains(&uv.x) || !(0.0..1.0).contains(&uv.y) {
             return 0.0;
         }
-        let row = self.marginal.bin_of(uv.y);
-        let col = self.rows[row].bin_of(uv.x);
-        self.rows[row].weight(col) / self.marginal.integral()
+        self.marginal.pdf(uv.y) * self.rows[self.marginal.bin_of(uv.y)].pdf(uv.x)
     }
 }
 
@@ -425,6 +468,37 @@ mod tests {
         let e: Vec<f64> = positive.iter().map(|&i| expected[i]).collect();
         // 6 positive cells → 5 dof.
         assert_eq!(assert_chi2(&o, &e).1, 5);
+    }
+
+    #[test]
+    fn tables_hold_one_f32_per_bin_and_report_the_density_they_sample() {
+        // A bin far below the f32 resolution of the row total gets width 0: never sampled, and
+        // its density is 0 too (what is reported is what is sampled).
+        let mut w = vec![1.0f32; 1000];
+        w[500] = 1e-12;
+        let d = Distribution1D::new(&w);
+        assert_eq!(d.pdf(500.5 / 1000.0), 0.0);
+        assert_eq!(d.bin_probability(500), 0.0);
+        let mut rng = Rng::new(3);
+        for _ in 0..5000 {
+            let s = d.sample(rng.uniform()).unwrap();
+            assert_ne!(s.index, 500);
+            assert_eq!(d.pdf(s.x), s.pdf);
+        }
+        let d2 = Distribution2D::from_rows(100, 50, |r, buf| {
+            buf.extend((0..100).map(|c| (r * 100 + c) as f32));
+        });
+        assert_eq!(
+            d2,
+            Distribution2D::new(100, 50, &(0..5000).map(|i| i as f32).collect::<Vec<_>>())
+        );
+        let bytes = d2.heap_bytes();
+        let min = 50 * 101 * 4 + 51 * 4;
+        assert!(bytes >= min && bytes <= min + 50 * 64, "{bytes}");
+        for _ in 0..2000 {
+            let s = d2.sample(rng.uniform2()).unwrap();
+            assert!((d2.pdf(s.uv) - s.pdf).abs() <= 1e-6 * s.pdf);
+        }
     }
 
     #[test]

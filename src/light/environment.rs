@@ -154,7 +154,7 @@ impl EnvironmentLight {
                 })?;
                 let img = read_rgb(path)?;
                 refuse_unusable(path, &img)?;
-                Self::from_image(&img, *intensity, *rotate)
+                Self::from_rgb(img, *intensity, *rotate)
             }
         })
     }
@@ -182,32 +182,54 @@ impl EnvironmentLight {
     /// * `intensity` – radiance multiplier (a negative or non-finite value gives a black light).
     /// * `rotate` – rotation of the map about +y in radians (right-handed).
     pub fn from_image(img: &RgbImage, intensity: f32, rotate: f32) -> EnvironmentLight {
+        Self::from_rgb(img.clone(), intensity, rotate)
+    }
+
+    /// [`from_image`](Self::from_image) taking the image: its pixels become the light's in place,
+    /// and the sampling tables add about 4 bytes per pixel ([`table_bytes`](Self::table_bytes)),
+    /// so a map costs about 16 bytes per pixel in all (12 of them its own `f32` RGB).
+    pub fn from_rgb(img: RgbImage, intensity: f32, rotate: f32) -> EnvironmentLight {
+        use rayon::prelude::*;
         let (width, height) = (img.width as usize, img.height as usize);
         let scale = positive_or_zero(intensity);
-        let mut invalid = 0;
-        let pixels: Vec<Spectrum> = (0..width * height)
-            .map(|i| {
-                let c = img.pixels.get(i).copied().unwrap_or_default();
+        let mut texels = img.pixels;
+        let invalid: usize = texels
+            .par_iter_mut()
+            .map(|c| {
                 if c.iter().all(|x| x.is_finite() && *x >= 0.0) {
-                    Spectrum(c) * scale
+                    *c = c.map(|x| x * scale);
+                    0
                 } else {
-                    invalid += 1;
-                    Spectrum::ZERO
+                    *c = [0.0; 3];
+                    1
                 }
             })
-            .collect();
-        let mut weights = Vec::with_capacity(pixels.len());
-        let mut integral = 0.0f64;
-        for row in 0..height {
+            .sum();
+        // The same allocation, viewed as spectra.
+        let mut pixels: Vec<Spectrum> = texels.into_iter().map(Spectrum).collect();
+        pixels.resize(width * height, Spectrum::ZERO);
+        let rows = |row: usize| {
             let (t0, t1) = (row as f32 / height as f32, (row + 1) as f32 / height as f32);
             let sin_mid = (PI * 0.5 * (t0 + t1)).sin();
             let solid = 2.0 * PI / width as f32 * ((PI * t0).cos() - (PI * t1).cos());
-            for c in &pixels[row * width..(row + 1) * width] {
-                weights.push(c.luminance() * sin_mid);
-                integral += f64::from(c.luminance() * solid);
-            }
-        }
-        let distribution = Distribution2D::new(width, height, &weights);
+            (&pixels[row * width..(row + 1) * width], sin_mid, solid)
+        };
+        let distribution = Distribution2D::from_rows(width, height, |row, buf| {
+            let (texels, sin_mid, _) = rows(row);
+            buf.extend(texels.iter().map(|c| c.luminance() * sin_mid));
+        });
+        // Row sums in parallel, added in row order (the same total for any thread count).
+        let row_sums: Vec<f64> = (0..height)
+            .into_par_iter()
+            .map(|row| {
+                let (texels, _, solid) = rows(row);
+                texels
+                    .iter()
+                    .map(|c| f64::from(c.luminance() * solid))
+                    .sum::<f64>()
+            })
+            .collect();
+        let integral: f64 = row_sums.iter().sum();
         let rotation = Vec2::from_angle(if rotate.is_finite() { rotate } else { 0.0 });
         EnvironmentLight {
             kind: Kind::Map(Box::new(Map {
@@ -220,6 +242,14 @@ impl EnvironmentLight {
             })),
             luminance_integral: integral as f32,
             invalid_pixels: invalid,
+        }
+    }
+
+    /// Bytes of heap the sampling tables of a map take (0 for other environments).
+    pub fn table_bytes(&self) -> usize {
+        match &self.kind {
+            Kind::Map(m) => m.distribution.heap_bytes(),
+            _ => 0,
         }
     }
 
