@@ -337,8 +337,13 @@ fn degenerate_environment_maps_are_refused_or_warned_about() {
         .to_string();
     assert!(e.contains("pixel (1, 1) is infinite"), "{e}");
     write_map(&s.path("huge.exr"), |i| if i == 10 { 1e30 } else { 1.0 });
-    let e = EnvironmentLight::new(&map("huge.exr")).unwrap_err().to_string();
-    assert!(e.contains("pixel (2, 1)") && e.contains("up to 1e12"), "{e}");
+    let e = EnvironmentLight::new(&map("huge.exr"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("pixel (2, 1)") && e.contains("up to 1e12"),
+        "{e}"
+    );
     write_map(&s.path("zero.exr"), |_| 0.0);
     let zero = EnvironmentLight::new(&map("zero.exr")).unwrap();
     assert!(
@@ -475,7 +480,7 @@ fn commands_piped_into_head_exit_quietly() {
     for args in [
         vec!["brdf", "--list"],
         vec!["brdf", "-m", "silver_paint", "--sample", "100000"],
-        vec!["brdf", "--samples", "2000"],
+        vec!["brdf"],
         vec![
             "brdf",
             "-m",
