@@ -58,7 +58,7 @@ fn signal(child: &Child, sig: &str) {
 /// A signal before the first pass completes: exit 130, "nothing written", the old files intact,
 /// no temporary file left.
 #[cfg(unix)]
-fn stopped_before_the_first_pass(name: &str, signals: &[&str]) {
+fn stopped_before_the_first_pass(name: &str, signals: &[&str], message: &str) {
     let s = Scratch::new("outputs", name);
     std::fs::write(s.path("out.exr"), b"old exr").unwrap();
     std::fs::write(s.path("out.png"), b"old png").unwrap();
@@ -74,7 +74,7 @@ fn stopped_before_the_first_pass(name: &str, signals: &[&str]) {
         "{:?}\nstderr:\n{err}",
         out.status
     );
-    assert!(err.contains("nothing written"), "{err}");
+    assert!(err.contains(message), "wanted `{message}` in:\n{err}");
     assert_eq!(std::fs::read(s.path("out.exr")).unwrap(), b"old exr");
     assert_eq!(std::fs::read(s.path("out.png")).unwrap(), b"old png");
     assert_eq!(s.files(), ["out.exr", "out.png"], "stray files");
@@ -83,19 +83,32 @@ fn stopped_before_the_first_pass(name: &str, signals: &[&str]) {
 #[cfg(unix)]
 #[test]
 fn sigterm_before_the_first_pass_writes_nothing() {
-    stopped_before_the_first_pass("sigterm", &["-TERM"]);
+    stopped_before_the_first_pass(
+        "sigterm",
+        &["-TERM"],
+        "stopped by Ctrl-C or SIGTERM before the first pass over the image completed: nothing written",
+    );
 }
 
 #[cfg(unix)]
 #[test]
 fn ctrl_c_before_the_first_pass_writes_nothing() {
-    stopped_before_the_first_pass("sigint", &["-INT"]);
+    stopped_before_the_first_pass(
+        "sigint",
+        &["-INT"],
+        "stopped by Ctrl-C or SIGTERM before the first pass over the image completed: nothing written",
+    );
 }
 
 #[cfg(unix)]
 #[test]
 fn a_second_signal_aborts_without_writing() {
-    stopped_before_the_first_pass("twice", &["-INT", "-TERM"]);
+    // Both arrive during setup, which does not stop for the first: the second aborts at once.
+    stopped_before_the_first_pass(
+        "twice",
+        &["-INT", "-TERM"],
+        "second interrupt: aborted, nothing written",
+    );
 }
 
 #[test]
