@@ -8,7 +8,7 @@
 use super::RecipeError;
 use std::ops::Range;
 
-mod index;
+pub mod index;
 mod odd;
 
 /// Largest description file read (bytes): recipes are hand-written text, and the limit keeps a
@@ -53,7 +53,13 @@ impl Source {
         };
         // The type first, without opening: says "is a directory", "is a FIFO", … (a FIFO would
         // block the read).
-        let meta = crate::image::input_kind::regular_file(path).map_err(|e| fail(e.to_string()))?;
+        let meta = crate::image::input_kind::regular_file(path).map_err(|e| {
+            use crate::image::input_kind::NotAFile;
+            match e {
+                NotAFile::Missing | NotAFile::Io(_) => fail(format!("cannot read the file: {e}")),
+                e => fail(e.to_string()),
+            }
+        })?;
         if meta.len() > MAX_FILE_BYTES {
             return Err(fail(format!(
                 "the file has {} bytes; description files may have at most {MAX_FILE_BYTES}",
@@ -328,6 +334,11 @@ impl Source {
     /// outside comments (looked up in an index built once, so locating many keys stays linear).
     pub fn key(&self, name: &str) -> Option<usize> {
         self.index.key(name)
+    }
+
+    /// How deeply brackets, map nodes and fields nest in the text (outside comments and strings).
+    pub fn nesting(&self) -> &index::Nesting {
+        self.index.nesting()
     }
 
     /// Where the call `ident("name")` (e.g. `Material("gold")`) is first written outside
