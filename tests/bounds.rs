@@ -153,3 +153,184 @@ fn a_large_environment_map_keeps_its_tables_small() {
     // The patch holds most of the light (~ 1600 · 5e3 against 33.5 M · 0.5).
     assert!(hits > 500, "{hits} of 2000 samples on the bright patch");
 }
+
+/// `n` map nodes nested inline: `n − 1` Switches (each with a Remap field and a second stop),
+/// the innermost holding a material.
+fn nested_switches(n: usize) -> String {
+    let mut s = String::from("Material(\"a\")");
+    for _ in 1..n {
+        s = format!(
+            "Switch(by: Remap(field: Perlin(scale: 1.0), from: (0.0, 1.0), to: (0.0, 1.0)),\n stops: [(0.0, {s}), (0.5, Material(\"a\"))], blend: 0.1)"
+        );
+    }
+    format!("(materials: {{ \"a\": (base: Lambert(albedo: Gray(0.5))) }},\n surface: {s})")
+}
+
+/// `n` fields nested inline: `Sum([Sum([… Constant(0.5) …, Constant(0)]), Constant(0)])`.
+fn nested_fields(n: usize) -> String {
+    let mut f = String::from("Constant(0.5)");
+    for _ in 1..n {
+        f = format!("Sum([{f}, Constant(0.0)])");
+    }
+    format!(
+        "(materials: {{ \"a\": (base: Lambert(albedo: Gray(0.5))) }},\n surface: Switch(by: {f}, stops: [(0.0, Material(\"a\"))]))"
+    )
+}
+
+fn check(text: &str) -> Result<lapidary::scene::Scene, lapidary::recipe::RecipeError> {
+    lapidary::recipe::GemRecipe::parse("nest.ron", text).and_then(|g| g.compile())
+}
+
+/// Inline nesting up to the documented 64 map levels (and 16 field levels) parses and compiles
+/// (16 inline Switches used to hit the RON parser's recursion limit); one more is refused at the
+/// first node too deep, in the project's words.
+#[test]
+fn inline_nesting_parses_up_to_the_limit_and_is_refused_beyond() {
+    for n in [16, 64] {
+        let scene = check(&nested_switches(n)).unwrap_or_else(|e| panic!("{n} levels: {e}"));
+        assert_eq!(scene.surface.map.max_trail(scene.surface.map.root), 0);
+    }
+    let text = nested_switches(65);
+    let e = check(&text).expect_err("65 levels");
+    assert_eq!(e.message, "map tree nested 65 deep; at most 64", "{e}");
+    // At the 65th node: the innermost `Material("a")`, on the last line but the closing ones.
+    let at = text.find("Material(\"a\")),").unwrap();
+    let line = text[..at].matches('\n').count() + 1;
+    assert_eq!(
+        (e.line, e.col),
+        (line, at - text[..at].rfind('\n').unwrap()),
+        "{e}"
+    );
+    let e = check(&nested_switches(300)).expect_err("300 levels");
+    assert_eq!(e.message, "map tree nested 300 deep; at most 64", "{e}");
+
+    check(&nested_fields(16)).unwrap_or_else(|e| panic!("16 fields: {e}"));
+    let text = nested_fields(17);
+    let e = check(&text).expect_err("17 fields");
+    assert_eq!(e.message, "field nested 17 deep; at most 16", "{e}");
+    assert_eq!(
+        (e.line, e.col),
+        (
+            2,
+            text.find("Constant(0.5)").unwrap() - text.find('\n').unwrap()
+        )
+    );
+
+    // Brackets of any kind, however deep, get a message before the parser recurses into them.
+    let text = format!("(materials: {}{})", "[".repeat(5000), "]".repeat(5000));
+    let e = check(&text).expect_err("deep brackets");
+    assert_eq!(e.message, "brackets nested 5001 deep; at most 256", "{e}");
+    assert_eq!((e.line, e.col), (1, 268), "{e}");
+}
+
+/// Every count a recipe gives is bounded where it is written: the message names the field and
+/// its limit, at `file:line:col` of the first element too many (or of the number).
+#[test]
+fn every_count_in_a_recipe_is_bounded_at_its_position() {
+    let mat = |extra: &str| format!("(base: Lambert(albedo: Gray(0.5)){extra})");
+    let gem = |extra: &str, surface: &str, stage: &str| {
+        format!(
+            "(materials: {{ \"a\": {} }},\n surface: {surface}{stage})",
+            mat(extra)
+        )
+    };
+    let list = |item: &str, n: usize| vec![item; n].join(", ");
+    let light = "Rect(center: (0.0, 5.0, 0.0), target: (0.0, 0.0, 0.0), size: (1.0, 1.0), radiance: Gray(1.0))";
+    let cases: Vec<(&str, String, String, &str)> = vec![
+        (
+            "Reference samples",
+            gem(", model: Reference(samples: 100000)", "Material(\"a\")", ""),
+            "samples: 100000".into(),
+            "samples = 100000 is out of range: allowed 1 ..= 256",
+        ),
+        (
+            "Reference max_depth",
+            gem(", model: Reference(max_depth: 5000)", "Material(\"a\")", ""),
+            "max_depth: 5000".into(),
+            "max_depth = 5000 is out of range: allowed 1 ..= 4096",
+        ),
+        (
+            "coats",
+            gem(
+                &format!(", coats: [{}]", list("(ior: 1.5, roughness: 3.0)", 17)),
+                "Material(\"a\")",
+                "",
+            ),
+            "".into(),
+            "coats: more than 16 elements; at most 16",
+        ),
+        (
+            "Sum inputs",
+            gem(
+                "",
+                &format!(
+                    "Switch(by: Sum([{}]), stops: [(0.0, Material(\"a\"))])",
+                    list("Constant(1.0)", 65)
+                ),
+                "",
+            ),
+            "".into(),
+            "inputs: more than 64 elements; at most 64",
+        ),
+        (
+            "lights",
+            gem(
+                "",
+                "Material(\"a\")",
+                &format!(", stage: (lights: [{}])", list(light, 65)),
+            ),
+            "".into(),
+            "lights: more than 64 elements; at most 64",
+        ),
+        (
+            "Voronoi octaves",
+            gem(
+                "",
+                "Switch(by: Perlin(scale: 1.0, octaves: 17), stops: [(0.0, Material(\"a\"))])",
+                "",
+            ),
+            "octaves: 17".into(),
+            "octaves = 17 is out of range: allowed 1 ..= 16",
+        ),
+    ];
+    for (what, text, at, message) in cases {
+        let e = check(&text).expect_err(what);
+        assert!(e.message.contains(message), "{what}: {e}");
+        assert!(e.line > 0 && e.col > 0, "{what}: {e}");
+        if !at.is_empty() {
+            let p = text.find(&at).unwrap();
+            let line = text[..p].matches('\n').count() + 1;
+            let col = p - text[..p].rfind('\n').map_or(0, |n| n + 1) + 1;
+            let value = at.split(": ").next().unwrap().len() + 2;
+            assert_eq!((e.line, e.col), (line, col + value), "{what}: {e}");
+        }
+    }
+
+    // A list one element within its bound is accepted.
+    let ok = gem(
+        &format!(", coats: [{}]", list("(ior: 1.5, roughness: 3.0)", 16)),
+        &format!(
+            "Switch(by: Sum([{}]), stops: [(0.0, Material(\"a\"))])",
+            list("Constant(1.0)", 64)
+        ),
+        &format!(", stage: (lights: [{}])", list(light, 64)),
+    );
+    check(&ok).unwrap_or_else(|e| panic!("{e}"));
+
+    // 100 001 materials: refused at the first one too many (in its name).
+    let mut text = String::from("(materials: {\n");
+    for i in 0..100_001 {
+        text += &format!("  \"m{i}\": (base: Lambert(albedo: Gray(0.5))),\n");
+    }
+    text += "}, surface: Material(\"m0\"))";
+    let e = check(&text).expect_err("too many materials");
+    assert_eq!(
+        (e.line, e.col, e.message.as_str()),
+        (
+            100_002,
+            4,
+            "materials: more than 100000 definitions; at most 100000"
+        ),
+        "{e}"
+    );
+}

@@ -248,6 +248,17 @@ impl<'a> Compiler<'a> {
     }
 
     fn push(&mut self, node: MapNode) -> NodeId {
+        if self.nodes.len() >= super::ranged::MAX_MAP_NODES {
+            if self.reported.insert("too many nodes".into()) {
+                let at = self.recipe.source.find(&["surface", ":"]);
+                let max = super::ranged::MAX_MAP_NODES;
+                self.errors.push(self.recipe.source.error(
+                    at,
+                    format!("surface: the map tree has more than {max} nodes; at most {max}"),
+                ));
+            }
+            return 0;
+        }
         self.nodes.push(node);
         (self.nodes.len() - 1) as NodeId
     }

@@ -56,13 +56,13 @@ pub struct GemDesc {
     #[serde(default, deserialize_with = "super::stage::any_seed")]
     pub seed: u64,
     /// Material libraries whose materials the tree may use, relative to this file.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "super::ranged::includes")]
     pub include: Vec<String>,
-    /// The recipe's own layered materials by name, in file order.
-    #[serde(default, deserialize_with = "super::ranged::unique_keys")]
+    /// The recipe's own layered materials by name, in file order (at most 100 000).
+    #[serde(default, deserialize_with = "super::ranged::materials")]
     pub materials: IndexMap<String, MaterialDesc>,
     /// Named sub-maps, usable as `Map("name")` anywhere in the tree.
-    #[serde(default, deserialize_with = "super::ranged::unique_keys")]
+    #[serde(default, deserialize_with = "super::ranged::named_maps")]
     pub maps: IndexMap<String, MapDesc>,
     /// The surface map tree.
     pub surface: MapDesc,
@@ -110,7 +110,7 @@ impl GemRecipe {
     /// Parses and resolves includes, collecting every error.
     fn read(source: Source, path: Option<&Path>) -> (Option<Self>, Vec<RecipeError>) {
         let mut errors = vec![];
-        let content: GemDesc = match source.parse() {
+        let content: GemDesc = match super::ranged::parse(&source) {
             Ok(c) => c,
             Err(e) => return (None, vec![e]),
         };

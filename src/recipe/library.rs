@@ -30,10 +30,10 @@ pub const MAX_INCLUDE_DEPTH: usize = 16;
 #[serde(deny_unknown_fields)]
 pub struct MaterialFile {
     /// Other library files whose materials this one uses, relative to this file.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "super::ranged::includes")]
     pub include: Vec<String>,
     /// Materials in file order.
-    #[serde(default, deserialize_with = "super::ranged::unique_keys")]
+    #[serde(default, deserialize_with = "super::ranged::materials")]
     pub materials: IndexMap<String, MaterialDesc>,
 }
 
@@ -90,7 +90,7 @@ impl MaterialLibrary {
         path: Option<&Path>,
         errors: &mut Vec<RecipeError>,
     ) -> Option<Self> {
-        let content: MaterialFile = match source.parse() {
+        let content: MaterialFile = match super::ranged::parse(&source) {
             Ok(c) => c,
             Err(e) => {
                 errors.push(e);
@@ -179,7 +179,7 @@ impl MaterialLibrary {
                     continue;
                 }
             };
-            let content: MaterialFile = match source.parse() {
+            let content: MaterialFile = match super::ranged::parse(&source) {
                 Ok(c) => c,
                 Err(e) => {
                     errors.push(e);
@@ -199,6 +199,16 @@ impl MaterialLibrary {
             );
             chain.pop();
             for (key, desc) in content.materials {
+                if self.materials.len() >= super::ranged::MAX_MATERIALS
+                    && !self.materials.contains_key(&key)
+                {
+                    errors.push(self.sources[from].error(at, format!(
+                        "include \"{name}\": more than {max} materials with the files before it; \
+                         at most {max} in all",
+                        max = super::ranged::MAX_MATERIALS
+                    )));
+                    break;
+                }
                 if let Some((_, earlier)) = self.materials.get(&key) {
                     let first = &self.sources[*earlier];
                     let (line, col) = first.key(&key).map_or((0, 0), |p| first.line_col(p));

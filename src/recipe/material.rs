@@ -89,6 +89,18 @@ pub enum BaseDesc {
     },
 }
 
+fn coat_list<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Vec<CoatDesc>, D::Error> {
+    super::ranged::bounded_list(d, "coats", super::ranged::MAX_COATS, false)
+}
+fn samples_range<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
+    let max = super::ranged::MAX_REFERENCE_SAMPLES;
+    super::ranged::whole(d, "samples", 1, max).map(|v| v as u32)
+}
+fn walk_depth_range<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
+    let max = super::ranged::MAX_REFERENCE_DEPTH;
+    super::ranged::whole(d, "max_depth", 1, max).map(|v| v as u32)
+}
+
 fn default_samples() -> u32 {
     ReferenceParams::default().samples
 }
@@ -107,11 +119,11 @@ pub enum ModelDesc {
     Corrected,
     /// Stochastic random walk.
     Reference {
-        /// Walks per evaluation (default 4).
-        #[serde(default = "default_samples")]
+        /// Walks per evaluation, 1 ..= 256 (default 4).
+        #[serde(default = "default_samples", deserialize_with = "samples_range")]
         samples: u32,
-        /// Maximum bounces per walk (default 256).
-        #[serde(default = "default_depth")]
+        /// Maximum bounces per walk, 1 ..= 4096 (default 256).
+        #[serde(default = "default_depth", deserialize_with = "walk_depth_range")]
         max_depth: u32,
     },
 }
@@ -137,8 +149,8 @@ fn yes() -> bool {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MaterialDesc {
-    /// Coats, top first (may be empty).
-    #[serde(default)]
+    /// Coats, top first (may be empty; at most 16).
+    #[serde(default, deserialize_with = "coat_list")]
     pub coats: Vec<CoatDesc>,
     /// The opaque base.
     pub base: BaseDesc,

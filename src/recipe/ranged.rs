@@ -33,39 +33,6 @@ macro_rules! ranged {
     };
 }
 
-/// Deserializes a name → value map, rejecting a name given twice (a plain map would keep the
-/// later one silently).
-pub(crate) fn unique_keys<'de, D, V>(d: D) -> Result<indexmap::IndexMap<String, V>, D::Error>
-where
-    D: serde::Deserializer<'de>,
-    V: serde::Deserialize<'de>,
-{
-    struct Visit<V>(std::marker::PhantomData<V>);
-    impl<'de, V: serde::Deserialize<'de>> serde::de::Visitor<'de> for Visit<V> {
-        type Value = indexmap::IndexMap<String, V>;
-        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-            f.write_str("a map from names to definitions")
-        }
-        fn visit_map<A: serde::de::MapAccess<'de>>(
-            self,
-            mut m: A,
-        ) -> Result<Self::Value, A::Error> {
-            let mut out = indexmap::IndexMap::new();
-            while let Some(key) = m.next_key::<String>()? {
-                if out.contains_key(&key) {
-                    return Err(serde::de::Error::custom(format!(
-                        "\"{key}\" is defined twice; names must be unique"
-                    )));
-                }
-                let value = m.next_value()?;
-                out.insert(key, value);
-            }
-            Ok(out)
-        }
-    }
-    d.deserialize_map(Visit(std::marker::PhantomData))
-}
-
 /// A finite `f32`.
 pub(crate) fn finite<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f32, D::Error> {
     let v = <f32 as serde::Deserialize>::deserialize(d)?;
@@ -148,4 +115,212 @@ pub(crate) fn whole<'de, D: serde::Deserializer<'de>>(
         }
     }
     d.deserialize_any(Visit { name, lo, hi })
+}
+
+/// Deepest inline nesting of map-tree nodes (the leaf counts): the runtime tree's own limit,
+/// [`crate::texture::map::MAX_DEPTH`], which the compiler also applies through named maps.
+pub const MAX_MAP_DEPTH: usize = crate::texture::map::MAX_DEPTH;
+/// Deepest nesting of fields (`Sum`, `Product`, `Remap` inside one another; the leaf counts).
+pub const MAX_FIELD_DEPTH: usize = 16;
+/// Deepest nesting of brackets of any kind in a description file: room for the deepest map tree
+/// (three brackets a level, as in `Switch(stops: [(0, …)])`) holding the deepest field.
+pub const MAX_BRACKETS: usize = 3 * MAX_MAP_DEPTH + 2 * MAX_FIELD_DEPTH + 32;
+/// The RON parser's own recursion limit: above anything [`MAX_BRACKETS`] admits (RON counts
+/// more than one level for some brackets), so the file's nesting is always reported in this
+/// project's words, before the parser runs.
+pub const RON_RECURSION_LIMIT: usize = 4 * MAX_BRACKETS;
+/// Stack of the thread description files are parsed on: deep enough for [`MAX_BRACKETS`] levels
+/// of serde's recursion in a debug build (reserved address space; pages are touched only as used).
+const PARSE_STACK_BYTES: usize = 256 << 20;
+
+/// Refuses text nested deeper than the documented limits, at the first place that goes too deep:
+/// map-tree nodes ([`MAX_MAP_DEPTH`]), fields ([`MAX_FIELD_DEPTH`]), then brackets of any kind
+/// ([`MAX_BRACKETS`]).
+pub(crate) fn check_nesting(source: &super::Source) -> Result<(), super::RecipeError> {
+    let n = source.nesting();
+    for (depth, max, what) in [
+        (&n.maps, MAX_MAP_DEPTH, "map tree"),
+        (&n.fields, MAX_FIELD_DEPTH, "field"),
+        (&n.brackets, MAX_BRACKETS, "brackets"),
+    ] {
+        if depth.deepest > max {
+            return Err(source.error(
+                depth.first_at(max + 1),
+                format!("{what} nested {} deep; at most {max}", depth.deepest),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Parses description text with the project's RON options, after the text's own checks
+/// ([`super::Source::check_text`]) and [`check_nesting`], on a thread with a stack deep enough
+/// for every nesting the checks admit.
+pub(crate) fn parse<T>(source: &super::Source) -> Result<T, super::RecipeError>
+where
+    T: serde::de::DeserializeOwned + Send,
+{
+    source.check_text()?;
+    check_nesting(source)?;
+    let run = || {
+        super::ron_options()
+            .with_recursion_limit(RON_RECURSION_LIMIT)
+            .from_str::<T>(&source.text)
+            .map_err(|e| source.ron_error(&e))
+    };
+    std::thread::scope(|s| {
+        match std::thread::Builder::new()
+            .name("parse".into())
+            .stack_size(PARSE_STACK_BYTES)
+            .spawn_scoped(s, run)
+        {
+            Ok(handle) => handle
+                .join()
+                .unwrap_or_else(|p| std::panic::resume_unwind(p)),
+            // No thread to be had: parse here, within the current stack.
+            Err(_) => run(),
+        }
+    })
+}
+
+/// Most materials a recipe may have, its own and included together (and most in one file).
+pub const MAX_MATERIALS: usize = 100_000;
+/// Most named maps in a recipe's `maps`.
+pub const MAX_NAMED_MAPS: usize = 100_000;
+/// Most entries of one Voronoi, and most stops of one Switch.
+pub const MAX_CHOICES: usize = 100_000;
+/// Most nodes a compiled map tree may have (named maps count once, however often used).
+pub const MAX_MAP_NODES: usize = 1_000_000;
+/// Most inputs of one `Sum` or `Product`.
+pub const MAX_FIELD_INPUTS: usize = 64;
+/// Most coats of one material.
+pub const MAX_COATS: usize = 16;
+/// Most files one `include` list names.
+pub const MAX_INCLUDES: usize = 256;
+/// Most walks per evaluation of the Reference model (`samples`).
+pub const MAX_REFERENCE_SAMPLES: u64 = 256;
+/// Most bounces of one Reference walk (`max_depth`).
+pub const MAX_REFERENCE_DEPTH: u64 = 4096;
+
+/// A list of at most `max` elements (and at least one when `non_empty`) for the field `name`;
+/// the error is raised at the first element too many, so it points into the file there.
+pub(crate) fn bounded_list<'de, D, T>(
+    d: D,
+    name: &'static str,
+    max: usize,
+    non_empty: bool,
+) -> Result<Vec<T>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+    T: serde::Deserialize<'de>,
+{
+    struct Visit<T> {
+        name: &'static str,
+        max: usize,
+        non_empty: bool,
+        item: std::marker::PhantomData<T>,
+    }
+    impl<'de, T: serde::Deserialize<'de>> serde::de::Visitor<'de> for Visit<T> {
+        type Value = Vec<T>;
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            write!(f, "a list of at most {} elements", self.max)
+        }
+        fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> Result<Vec<T>, A::Error> {
+            let mut out = Vec::with_capacity(seq.size_hint().unwrap_or(0).min(self.max));
+            while let Some(v) = seq.next_element()? {
+                if out.len() == self.max {
+                    return Err(serde::de::Error::custom(format!(
+                        "{}: more than {} elements; at most {}",
+                        self.name, self.max, self.max
+                    )));
+                }
+                out.push(v);
+            }
+            if self.non_empty && out.is_empty() {
+                return Err(serde::de::Error::custom(
+                    "the list is empty; give at least one element",
+                ));
+            }
+            Ok(out)
+        }
+    }
+    d.deserialize_seq(Visit {
+        name,
+        max,
+        non_empty,
+        item: std::marker::PhantomData,
+    })
+}
+
+/// `include`: at most [`MAX_INCLUDES`] files.
+pub(crate) fn includes<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Vec<String>, D::Error> {
+    bounded_list(d, "include", MAX_INCLUDES, false)
+}
+
+/// `materials`: unique names, at most [`MAX_MATERIALS`].
+pub(crate) fn materials<'de, D, V>(d: D) -> Result<indexmap::IndexMap<String, V>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+    V: serde::Deserialize<'de>,
+{
+    bounded_keys(d, "materials", MAX_MATERIALS)
+}
+
+/// `maps`: unique names, at most [`MAX_NAMED_MAPS`].
+pub(crate) fn named_maps<'de, D, V>(d: D) -> Result<indexmap::IndexMap<String, V>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+    V: serde::Deserialize<'de>,
+{
+    bounded_keys(d, "maps", MAX_NAMED_MAPS)
+}
+
+/// A name → value map, rejecting a name given twice (a plain map would keep the later one
+/// silently) and more than `max` names (the error at the first name too many).
+fn bounded_keys<'de, D, V>(
+    d: D,
+    name: &'static str,
+    max: usize,
+) -> Result<indexmap::IndexMap<String, V>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+    V: serde::Deserialize<'de>,
+{
+    struct Bounded<V>(indexmap::IndexMap<String, V>);
+    struct Visit<V> {
+        name: &'static str,
+        max: usize,
+        value: std::marker::PhantomData<V>,
+    }
+    impl<'de, V: serde::Deserialize<'de>> serde::de::Visitor<'de> for Visit<V> {
+        type Value = Bounded<V>;
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            write!(f, "a map from names to definitions")
+        }
+        fn visit_map<A: serde::de::MapAccess<'de>>(self, mut m: A) -> Result<Bounded<V>, A::Error> {
+            let mut out = indexmap::IndexMap::new();
+            while let Some(key) = m.next_key::<String>()? {
+                if out.contains_key(&key) {
+                    return Err(serde::de::Error::custom(format!(
+                        "\"{key}\" is defined twice; names must be unique"
+                    )));
+                }
+                if out.len() == self.max {
+                    return Err(serde::de::Error::custom(format!(
+                        "{}: more than {} definitions; at most {}",
+                        self.name, self.max, self.max
+                    )));
+                }
+                let value = m.next_value()?;
+                out.insert(key, value);
+            }
+            Ok(Bounded(out))
+        }
+    }
+    d.deserialize_map(Visit {
+        name,
+        max,
+        value: std::marker::PhantomData,
+    })
+    .map(|b| b.0)
 }

@@ -110,6 +110,13 @@ fn count<'de, D: Deserializer<'de>>(
     Ok(Some(v as u32)) // within `hi`, a u32
 }
 
+/// Most area lights of a stage (every shading point tests each of them).
+pub const MAX_LIGHTS: usize = 64;
+
+fn light_list<'de, D: Deserializer<'de>>(d: D) -> Result<Option<Vec<LightDesc>>, D::Error> {
+    super::ranged::bounded_list(d, "lights", MAX_LIGHTS, false).map(Some)
+}
+
 fn size_range<'de, D: Deserializer<'de>>(d: D) -> Result<Option<u32>, D::Error> {
     count(d, "image size", 1, 16384)
 }
@@ -162,8 +169,8 @@ pub struct StageDesc {
     /// Light from infinitely far away.
     #[serde(default)]
     pub environment: Option<EnvironmentDesc>,
-    /// Area lights (the list replaces the studio's soft boxes; `[]` removes them).
-    #[serde(default)]
+    /// Area lights (the list replaces the studio's soft boxes; `[]` removes them; at most 64).
+    #[serde(default, deserialize_with = "light_list")]
     pub lights: Option<Vec<LightDesc>>,
     /// The camera.
     #[serde(default)]

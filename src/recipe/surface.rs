@@ -54,19 +54,28 @@ fn axis_check<'de, D: Deserializer<'de>>(d: D) -> Result<(f32, f32, f32), D::Err
     }
 }
 
-fn non_empty<'de, D, T>(d: D) -> Result<Vec<T>, D::Error>
+fn choices<'de, D, T>(d: D) -> Result<Vec<T>, D::Error>
 where
     D: Deserializer<'de>,
     T: Deserialize<'de>,
 {
-    let v = Vec::<T>::deserialize(d)?;
-    if v.is_empty() {
-        Err(serde::de::Error::custom(
-            "the list is empty; give at least one element",
-        ))
-    } else {
-        Ok(v)
-    }
+    super::ranged::bounded_list(d, "entries", super::ranged::MAX_CHOICES, true)
+}
+
+fn stop_list<'de, D, T>(d: D) -> Result<Vec<T>, D::Error>
+where
+    D: Deserializer<'de>,
+    T: Deserialize<'de>,
+{
+    super::ranged::bounded_list(d, "stops", super::ranged::MAX_CHOICES, false)
+}
+
+fn inputs<'de, D, T>(d: D) -> Result<Vec<T>, D::Error>
+where
+    D: Deserializer<'de>,
+    T: Deserialize<'de>,
+{
+    super::ranged::bounded_list(d, "inputs", super::ranged::MAX_FIELD_INPUTS, true)
 }
 
 fn interval<'de, D: Deserializer<'de>>(d: D) -> Result<(f32, f32), D::Error> {
@@ -151,8 +160,9 @@ pub enum MapDesc {
         /// Seed; default: derived from the recipe seed and the node's position in the file.
         #[serde(default)]
         seed: Option<u64>,
-        /// `(weight, node)` pairs; each filled cell picks one with probability ∝ weight.
-        #[serde(deserialize_with = "non_empty")]
+        /// `(weight, node)` pairs (1 ..= 100 000); each filled cell picks one with probability ∝
+        /// weight.
+        #[serde(deserialize_with = "choices")]
         entries: Vec<(Weight, MapDesc)>,
         /// Fraction of filled cells, 0 ..= 1 (default 1); the rest are transparent.
         #[serde(default = "one", deserialize_with = "fill_range")]
@@ -196,7 +206,8 @@ pub enum BumpDesc {
 pub struct SwitchRaw {
     /// The field compared with the thresholds.
     pub by: FieldDesc,
-    /// `(threshold, node)`, thresholds strictly ascending.
+    /// `(threshold, node)`, thresholds strictly ascending (at most 100 000).
+    #[serde(deserialize_with = "stop_list")]
     pub stops: Vec<(f32, MapDesc)>,
     /// Width of the stochastic band around each threshold (field units), default 0.
     #[serde(default)]
@@ -318,10 +329,10 @@ pub enum FieldDesc {
         #[serde(default)]
         seed: Option<u64>,
     },
-    /// Sum of fields.
-    Sum(#[serde(deserialize_with = "non_empty")] Vec<FieldDesc>),
-    /// Product of fields.
-    Product(#[serde(deserialize_with = "non_empty")] Vec<FieldDesc>),
+    /// Sum of fields (1 ..= 64 inputs).
+    Sum(#[serde(deserialize_with = "inputs")] Vec<FieldDesc>),
+    /// Product of fields (1 ..= 64 inputs).
+    Product(#[serde(deserialize_with = "inputs")] Vec<FieldDesc>),
     /// Linear remap `from → to`, optionally clamped to `to`.
     Remap {
         /// The input.
