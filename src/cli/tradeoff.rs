@@ -504,6 +504,7 @@ mod tests {
     fn default_settings_parse() {
         for s in DEFAULT_SETTINGS {
             assert!(s.parse::<Knobs>().is_ok(), "{s}");
+            assert_eq!(super::super::knobs::check_setting(s), Ok(()), "{s}");
         }
         assert!(parse_spp("12").is_err() && parse_spp("2").is_err() && parse_spp("64").is_ok());
         assert!(parse_budget("0").is_err() && parse_budget("3.5").is_ok());
