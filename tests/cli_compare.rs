@@ -245,8 +245,14 @@ fn a_bias_within_every_pixels_noise_fails_the_aggregate_test() {
         "{report}"
     );
     assert!(
-        field(&report, "bias").contains("α 0.01 shared by 3 scales (Šidák)"),
+        field(&report, "bias").contains("α 0.01 shared by 4 scales (Šidák)"),
         "{report}"
+    );
+    // The 16² and 8² tiles (partial at the bottom: 32 × 24) and the materials (stone, floor).
+    let material = field(&report, "material");
+    assert!(
+        material.starts_with("2 materials ") && material.contains("of the pixels of material "),
+        "{material}"
     );
     for (label, tiles) in [
         ("image", "1 tile "),
@@ -270,7 +276,7 @@ fn a_bias_within_every_pixels_noise_fails_the_aggregate_test() {
     );
     // The same file against itself passes every scale.
     let report = status(&s.compare("ref.exr", "ref.exr", &[]), 0);
-    for label in ["image", "16x16", "8x8"] {
+    for label in ["image", "16x16", "8x8", "material"] {
         assert!(field(&report, label).ends_with("pass"), "{report}");
     }
 }

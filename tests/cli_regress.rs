@@ -49,7 +49,22 @@ fn a_suite_passes_fails_and_reports_unusable_input() {
         stdout.contains("coated") && stdout.contains("bright"),
         "{stdout}"
     );
-    assert_eq!(stdout.matches(" pass").count(), 2, "{stdout}");
+    assert_eq!(
+        stdout.lines().filter(|l| l.ends_with(" pass")).count(),
+        2,
+        "{stdout}"
+    );
+    // Each row is followed by its per-scale verdicts; a summary closes the table.
+    assert_eq!(
+        stdout.matches("    bias |z|/limit: image ").count(),
+        2,
+        "{stdout}"
+    );
+    assert!(stdout.contains(", 16x16 ") && stdout.contains(", 8x8 "));
+    assert!(
+        stdout.contains("summary: 2 passed, 0 failed, 0 unusable"),
+        "{stdout}"
+    );
 
     // One IOR changed: that recipe fails, its render and heatmap are written.
     std::fs::write(
@@ -61,6 +76,11 @@ fn a_suite_passes_fails_and_reports_unusable_input() {
     let stdout = text(&out.stdout);
     assert_eq!(out.status.code(), Some(1), "{stdout}");
     assert!(stdout.contains("FAIL"), "{stdout}");
+    assert!(stdout.contains("    fails: "), "{stdout}");
+    assert!(
+        stdout.contains("summary: 1 passed, 1 failed, 0 unusable (failures by test: "),
+        "{stdout}"
+    );
     assert!(
         s.path("regress-out/coated-heatmap.png").exists(),
         "{stdout}"
@@ -93,4 +113,85 @@ fn an_empty_or_missing_folder_is_an_error() {
     let out = regress(&s.0, &[]);
     assert_eq!(out.status.code(), Some(2));
     assert!(text(&out.stderr).contains("suite"));
+}
+
+/// Multiplies `img`'s R, G, B by `gain` where the stone is (`material.Y` ≥ 0; the sky behind
+/// it is noise-free, so the per-pixel test would see any change there).
+fn brighten(img: &mut lapidary::image::ExrImage, gain: f32) {
+    let stone: Vec<bool> = img
+        .channel("material.Y")
+        .unwrap()
+        .iter()
+        .map(|&m| m >= 0.0)
+        .collect();
+    for c in img
+        .channels
+        .iter_mut()
+        .filter(|c| ["R", "G", "B"].contains(&&*c.name))
+    {
+        for (v, _) in c.data.iter_mut().zip(&stone).filter(|(_, s)| **s) {
+            *v *= gain;
+        }
+    }
+}
+
+#[test]
+fn a_bias_below_the_pixel_noise_fails_and_the_table_says_at_which_scale() {
+    use lapidary::image::{read_exr, write_exr};
+    let s = Scratch::new("regress", "bias");
+    let suite = s.path("suite");
+    std::fs::create_dir_all(&suite).unwrap();
+    std::fs::write(suite.join("coated.ron"), RECIPE).unwrap();
+    let out = regress(&s.0, &["--update", "--ref-spp", "512", "--size", "32x24"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    // The stone 3 % too dark in the reference: every pixel's z stays small, the whole image's
+    // does not.
+    let path = suite.join("coated.exr");
+    let mut reference = read_exr(&path).unwrap();
+    brighten(&mut reference, 0.97);
+    write_exr(&path, &reference).unwrap();
+    let out = regress(&s.0, &[]);
+    let stdout = text(&out.stdout);
+    assert_eq!(out.status.code(), Some(1), "{stdout}");
+    assert!(
+        stdout.contains("100.00 %"),
+        "pixel test should pass: {stdout}"
+    );
+    assert!(stdout.contains("    bias |z|/limit: image "), "{stdout}");
+    assert!(stdout.contains(" FAIL, 16x16"), "{stdout}");
+    assert!(
+        stdout.contains("    fails: bias at image: |z| "),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("(failures by test: pixel z-test 0, bias image 1"),
+        "{stdout}"
+    );
+
+    // Without variance in the reference, a 1 % bias fails on the mean ratio (relMSE passes),
+    // and passes with a looser --mean-tolerance.
+    let mut reference = read_exr(&path).unwrap();
+    brighten(&mut reference, 1.01 / 0.97);
+    reference
+        .channels
+        .retain(|c| !c.name.starts_with("variance."));
+    write_exr(&path, &reference).unwrap();
+    let out = regress(&s.0, &[]);
+    let stdout = text(&out.stdout);
+    assert_eq!(out.status.code(), Some(1), "{stdout}");
+    assert!(
+        stdout.contains("z-tests skipped (the reference has no variance"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("outside 1 ± 0.005"), "{stdout}");
+    assert!(!stdout.contains("relMSE 1"), "{stdout}");
+    let out = regress(&s.0, &["--mean-tolerance", "0.02"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stdout));
+    // The tolerance is a bounded fraction.
+    for bad in ["2", "-0.1", "nan", "1%"] {
+        let out = regress(&s.0, &[&format!("--mean-tolerance={bad}")]);
+        assert_eq!(out.status.code(), Some(2));
+        let err = text(&out.stderr);
+        assert!(err.contains("not a fraction in [0, 1]"), "{err}");
+    }
 }

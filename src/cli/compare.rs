@@ -7,7 +7,7 @@
 
 use crate::image::compare::{
     AGGREGATE_ALPHA, CompareError, Comparison, MEAN_TOLERANCE, Options, REL_MSE_THRESHOLD, Rgb,
-    Role, TestVariance, ZTest, compare_with,
+    Role, Scale, TestVariance, ZTest, compare_with,
 };
 use crate::image::{read_exr, write_heatmap};
 use anyhow::{Result, anyhow};
@@ -187,7 +187,7 @@ fn report(test: &Path, reference: &Path, c: &Comparison) -> String {
             out.push('\n');
             let _ = writeln!(
                 out,
-                "  bias      mean difference per tile, α {} shared by {} scales (Šidák):",
+                "  bias      mean difference per tile or material, α {} shared by {} scales (Šidák):",
                 AGGREGATE_ALPHA,
                 z.scales.len()
             );
@@ -226,10 +226,14 @@ fn report(test: &Path, reference: &Path, c: &Comparison) -> String {
 pub fn scale_lines(z: &ZTest) -> String {
     let mut out = String::new();
     for s in &z.scales {
-        let tiles = format!("{} tile{}", s.tiles, if s.tiles == 1 { "" } else { "s" });
+        let unit = match s.scale {
+            Scale::Material => "material",
+            _ => "tile",
+        };
+        let tiles = format!("{} {unit}{}", s.tiles, if s.tiles == 1 { "" } else { "s" });
         let _ = write!(
             out,
-            "    {:<8} {tiles:>10}   |z| max {:>6.2}   limit {:.2}   ",
+            "    {:<8} {tiles:>12}   |z| max {:>6.2}   limit {:.2}   ",
             s.label(),
             s.max_abs_z,
             s.z_crit
@@ -238,14 +242,11 @@ pub fn scale_lines(z: &ZTest) -> String {
             (Some(w), false) => {
                 let _ = writeln!(
                     out,
-                    "FAIL ({} tile channel{}; worst {} of the {}x{} tile at ({}, {}), z {:+.2})",
+                    "FAIL ({} group channel{}; worst {} of {}, z {:+.2})",
                     s.failed,
                     if s.failed == 1 { "" } else { "s" },
                     w.channel,
-                    w.width,
-                    w.height,
-                    w.x,
-                    w.y,
+                    w.region,
                     w.z
                 );
             }
@@ -294,7 +295,7 @@ pub fn failure_reasons(c: &Comparison) -> Vec<String> {
                     s.z_crit
                 );
                 if let Some(w) = &s.worst {
-                    let _ = write!(line, " in {} of the tile at ({}, {})", w.channel, w.x, w.y);
+                    let _ = write!(line, " in {} of {}", w.channel, w.region);
                 }
                 why.push(line);
             }

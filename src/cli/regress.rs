@@ -1,11 +1,12 @@
 //! `lapidary regress DIR`: a user's own regression suite. `DIR` holds recipes (`NAME.ron`) with
 //! their references beside them (`NAME.exr`, made once with `--update`). Each recipe is rendered
-//! at its reference's size, fast (default 256 spp, independent sampler, seed 7), and z-tested
-//! against the reference like `lapidary compare`; a table shows every result. Exit status: 0 all
-//! pass, 1 some fail, 2 unusable input (a recipe without reference, an unreadable reference, a
+//! at its reference's size, fast (default 256 spp, independent sampler, seed 7), and tested
+//! against the reference like `lapidary compare` (per-pixel z-test and the aggregate test at
+//! each tile scale); a table shows every result, each row followed by its per-scale verdicts,
+//! and a summary counts the failures by kind. Exit status: 0 all pass, 1 some fail, 2 unusable input (a recipe without reference, an unreadable reference, a
 //! recipe that does not compile, an empty folder).
 
-use crate::image::compare::{Comparison, compare};
+use crate::image::compare::{Comparison, Options, compare_with};
 use crate::image::write_heatmap;
 use crate::image::{ExrImage, read_exr, write_exr};
 use crate::recipe::GemRecipe;
@@ -41,6 +42,12 @@ pub struct RegressArgs {
     /// Size of references made by `--update` (default: the recipe's).
     #[arg(long, value_parser = super::render::parse_size)]
     pub size: Option<(u32, u32)>,
+    /// Largest |mean_t/mean_r − 1| of a channel that passes when a reference has no variance
+    /// (the z-tests cannot run): a fraction in [0, 1].
+    #[arg(long, value_name = "FRACTION",
+          default_value_t = crate::image::compare::MEAN_TOLERANCE,
+          value_parser = super::compare::parse_mean_tolerance)]
+    pub mean_tolerance: f64,
     /// Worker threads (default: one per core).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub threads: Option<u32>,
@@ -104,15 +111,20 @@ fn recipes(dir: &Path) -> Result<Vec<PathBuf>> {
 
 /// One table row.
 fn row(name: &str, c: &Comparison, spp: u32, secs: f64) -> String {
-    let (pass, max_z) = match &c.ztest {
+    let (pass, max_z, bias) = match &c.ztest {
         Some(z) => (
             format!("{:.2} %", 100.0 * z.pass_fraction),
             format!("{:.2}", z.max_abs_z),
+            format!(
+                "{}/{} ok",
+                z.scales.iter().filter(|s| s.passed).count(),
+                z.scales.len()
+            ),
         ),
-        None => ("—".to_string(), "—".to_string()),
+        None => ("—".to_string(), "—".to_string(), "—".to_string()),
     };
     format!(
-        "{name:<24} {:>9} {spp:>6} {pass:>10} {max_z:>7} {:>9.2e} {:>8.1} {:>6.1} s  {}",
+        "{name:<24} {:>9} {spp:>6} {pass:>10} {max_z:>7} {bias:>8} {:>9.2e} {:>8.1} {:>6.1} s  {}",
         format!("{}x{}", c.width, c.height),
         c.rel_mse,
         c.psnr,
@@ -176,16 +188,18 @@ pub fn run(args: &RegressArgs) -> Result<Outcome> {
         return Ok(outcome);
     }
     outln!(
-        "{:<24} {:>9} {:>6} {:>10} {:>7} {:>9} {:>8} {:>8}  verdict",
+        "{:<24} {:>9} {:>6} {:>10} {:>7} {:>8} {:>9} {:>8} {:>8}  verdict",
         "recipe",
         "size",
         "spp",
         "pixels ok",
         "max |z|",
+        "scales",
         "relMSE",
         "PSNR dB",
         "time"
     );
+    let mut tally = Tally::default();
     for (recipe, file) in list.iter().zip(&files) {
         let name = recipe
             .file_stem()
@@ -218,7 +232,10 @@ pub fn run(args: &RegressArgs) -> Result<Outcome> {
             }
         };
         let secs = start.elapsed().as_secs_f64();
-        let c = match compare(&test, &reference) {
+        let options = Options {
+            mean_tolerance: args.mean_tolerance,
+        };
+        let c = match compare_with(&test, &reference, &options) {
             Ok(c) => c,
             Err(e) => {
                 outln!("{name:<24} unusable: {e}");
@@ -227,7 +244,22 @@ pub fn run(args: &RegressArgs) -> Result<Outcome> {
             }
         };
         outln!("{}", row(&name, &c, args.spp, secs));
+        tally.count(&c);
+        match &c.ztest {
+            Some(z) => outln!("    bias |z|/limit: {}", super::compare::scale_summary(z)),
+            None => outln!(
+                "    z-tests skipped ({}); mean ratio {:.4} {:.4} {:.4}",
+                c.ztest_skipped.as_deref().unwrap_or("no variance"),
+                c.mean_ratio.ratio[0],
+                c.mean_ratio.ratio[1],
+                c.mean_ratio.ratio[2]
+            ),
+        }
         if !c.passed {
+            outln!(
+                "    fails: {}",
+                super::compare::failure_reasons(&c).join("; ")
+            );
             std::fs::create_dir_all(&args.out)
                 .map_err(|e| anyhow!("{}: {e}", args.out.display()))?;
             let t = args.out.join(format!("{name}-test.exr"));
@@ -243,5 +275,60 @@ pub fn run(args: &RegressArgs) -> Result<Outcome> {
             }
         }
     }
+    tally.unusable = list.len() - tally.passed - tally.failed;
+    outln!("{}", tally.summary());
     Ok(outcome)
+}
+
+/// Counts of a suite's outcomes, for the summary line.
+#[derive(Debug, Default)]
+struct Tally {
+    passed: usize,
+    failed: usize,
+    unusable: usize,
+    /// Failures of the per-pixel z-test.
+    pixel: usize,
+    /// Failures of the aggregate test, per scale label.
+    scales: Vec<(String, usize)>,
+    /// Failures without the z-tests (relMSE, NaN, mean ratio).
+    no_variance: usize,
+}
+
+impl Tally {
+    fn count(&mut self, c: &Comparison) {
+        if c.passed {
+            self.passed += 1;
+            return;
+        }
+        self.failed += 1;
+        let Some(z) = &c.ztest else {
+            self.no_variance += 1;
+            return;
+        };
+        if !z.pixels_passed {
+            self.pixel += 1;
+        }
+        for s in z.scales.iter().filter(|s| !s.passed) {
+            match self.scales.iter_mut().find(|(l, _)| *l == s.label()) {
+                Some((_, n)) => *n += 1,
+                None => self.scales.push((s.label(), 1)),
+            }
+        }
+    }
+
+    fn summary(&self) -> String {
+        let mut out = format!(
+            "summary: {} passed, {} failed, {} unusable",
+            self.passed, self.failed, self.unusable
+        );
+        if self.failed > 0 {
+            let mut kinds = vec![format!("pixel z-test {}", self.pixel)];
+            kinds.extend(self.scales.iter().map(|(l, n)| format!("bias {l} {n}")));
+            if self.no_variance > 0 {
+                kinds.push(format!("without variance {}", self.no_variance));
+            }
+            out += &format!(" (failures by test: {})", kinds.join(", "));
+        }
+        out
+    }
 }

@@ -109,6 +109,7 @@ mod tests {
             rgb: [&rgb[0], &rgb[1], &rgb[2]],
             variance: None,
             samples: None,
+            material: None,
         }
     }
 

@@ -26,7 +26,9 @@
 //! the 10–30 % noise of a 256-spp pixel, but not below the noise of a sum of many pixels. The
 //! image is cut into square tiles of [`TILE_BLOCKS`] = 32², 16² and 8² pixels from the top left
 //! (edge tiles partial, with their actual pixels), plus the whole image as one tile; a block
-//! size that would give a single tile is left out. Per tile and channel
+//! size that would give a single tile is left out. A bias of one material is spread over the
+//! image (the cells of an aventurine): when the reference (else the test) has a `material.Y`
+//! channel, each of its values is one more group, [`Scale::Material`]. Per group and channel
 //! `z = Σ(t − r) / √Σ(var_t + var_r)` over its pixels with variance (failed pixels and
 //! zero-variance channels, judged per pixel, are left out). The scales share the family-wise
 //! [`AGGREGATE_ALPHA`] = 0.01 by Šidák (`α_s = 1 − (1 − α)^(1/S)` for `S` scales), and each scale
@@ -142,53 +144,99 @@ impl Default for Options {
     }
 }
 
-/// One tile channel of the aggregate test.
+/// How the aggregate test groups the pixels at one scale.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Scale {
+    /// The whole image as one group.
+    Image,
+    /// Square tiles of this side in pixels from the top left (edge tiles partial).
+    Block(u32),
+    /// One group per value of the reference's `material.Y` (the material of each pixel's first
+    /// sample; −1 floor, −2 nothing), wherever its pixels are.
+    Material,
+}
+
+impl Scale {
+    /// `image`, `32x32` etc., or `material`.
+    pub fn label(&self) -> String {
+        match self {
+            Scale::Image => "image".into(),
+            Scale::Block(b) => format!("{b}x{b}"),
+            Scale::Material => "material".into(),
+        }
+    }
+}
+
+/// Where a group of the aggregate test is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Region {
+    /// A rectangle of pixels.
+    Rect {
+        /// Left column (pixels from the left).
+        x: u32,
+        /// Top row (pixels from the top).
+        y: u32,
+        /// Width in pixels (smaller than the block at the right edge).
+        width: u32,
+        /// Height in pixels (smaller than the block at the bottom edge).
+        height: u32,
+    },
+    /// The pixels of one `material.Y` value.
+    Material(i32),
+}
+
+impl std::fmt::Display for Region {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Region::Rect {
+                x,
+                y,
+                width,
+                height,
+            } => write!(f, "the {width}x{height} tile at ({x}, {y})"),
+            Region::Material(m) => write!(f, "the pixels of material {m}"),
+        }
+    }
+}
+
+/// One group and channel of the aggregate test.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TileZ {
-    /// Left column of the tile (pixels from the left).
-    pub x: u32,
-    /// Top row of the tile (pixels from the top).
-    pub y: u32,
-    /// Width in pixels (smaller than the block at the right edge).
-    pub width: u32,
-    /// Height in pixels (smaller than the block at the bottom edge).
-    pub height: u32,
+    /// The group.
+    pub region: Region,
     /// The channel.
     pub channel: Rgb,
-    /// `Σ(t − r) / √Σ(var_t + var_r)` over the tile; positive when the test is brighter.
+    /// `Σ(t − r) / √Σ(var_t + var_r)` over the group; positive when the test is brighter.
     pub z: f64,
 }
 
 /// The aggregate test at one scale.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ScaleTest {
-    /// Side of the square tiles in pixels; `None` for the whole image as one tile.
-    pub block: Option<u32>,
-    /// Tiles at this scale (partial edge tiles included).
+    /// How the pixels are grouped.
+    pub scale: Scale,
+    /// Groups (tiles, partial edge tiles included, or materials) at this scale.
     pub tiles: usize,
-    /// Tile channels tested (those with variance): the `N` of this scale's Šidák correction.
+    /// Group channels tested (those with variance): the `N` of this scale's Šidák correction.
     pub tested: usize,
     /// This scale's family-wise significance, [`AGGREGATE_ALPHA`] split over the scales.
     pub alpha: f64,
-    /// Critical |z| of each tile channel (two-sided, after the Šidák split over `tested`).
+    /// Critical |z| of each group channel (two-sided, after the Šidák split over `tested`).
     pub z_crit: f64,
-    /// Largest |z| over the tested tile channels (0 if none).
+    /// Largest |z| over the tested group channels (0 if none).
     pub max_abs_z: f64,
-    /// The tile channel of the largest |z|.
+    /// The group channel of the largest |z|.
     pub worst: Option<TileZ>,
-    /// Tile channels beyond `z_crit`.
+    /// Group channels beyond `z_crit`.
     pub failed: usize,
-    /// Whether no tile channel is beyond `z_crit`.
+    /// Whether no group channel is beyond `z_crit`.
     pub passed: bool,
 }
 
 impl ScaleTest {
-    /// `image` for the whole image, else `32x32` etc.
+    /// The scale's [label](Scale::label).
     pub fn label(&self) -> String {
-        match self.block {
-            None => "image".into(),
-            Some(b) => format!("{b}x{b}"),
-        }
+        self.scale.label()
     }
 }
 
@@ -215,7 +263,7 @@ pub struct ZTest {
     pub test_variance: TestVariance,
     /// Whether `pass_fraction ≥ required_fraction`.
     pub pixels_passed: bool,
-    /// The aggregate test, whole image first, then from the largest tiles to the smallest.
+    /// The aggregate test: whole image, tiles from the largest to the smallest, materials.
     pub scales: Vec<ScaleTest>,
     /// Whether the pixel test and every scale passed.
     pub passed: bool,

@@ -12,6 +12,8 @@ pub(super) struct Planes<'a> {
     pub variance: Option<[&'a [f32]; 3]>,
     /// Samples per pixel, if known.
     pub samples: Option<Samples<'a>>,
+    /// `material.Y`, if present.
+    pub material: Option<&'a [f32]>,
 }
 
 /// An image's sample counts.
@@ -76,6 +78,7 @@ pub(super) fn planes(img: &ExrImage, which: Role) -> Result<Planes<'_>, CompareE
         rgb,
         variance,
         samples,
+        material: get("material.Y"),
     })
 }
 

@@ -1,64 +1,121 @@
-//! The aggregate (bias) test: the z-score of the summed difference over tiles at several scales,
-//! `z = Σ(t − r)/√Σ(var_t + var_r)` per tile and channel, which sees a shift far below the noise
-//! of single pixels.
+//! The aggregate (bias) test: the z-score of the summed difference over groups of pixels at
+//! several scales, `z = Σ(t − r)/√Σ(var_t + var_r)` per group and channel, which sees a shift far
+//! below the noise of single pixels. The groups are square tiles, the whole image, and the
+//! pixels of each material.
 
 use super::planes::Pixel;
-use super::{AGGREGATE_ALPHA, Rgb, ScaleTest, TILE_BLOCKS, TileZ};
+use super::{AGGREGATE_ALPHA, Region, Rgb, Scale, ScaleTest, TILE_BLOCKS, TileZ};
 use crate::image::stats::{normal_quantile_two_sided, sidak};
+use std::collections::BTreeMap;
 
-/// The tile sides tested on a `width × height` image: the whole image (`None`) and each of
+/// The geometric scales tested on a `width × height` image: the whole image and each of
 /// [`TILE_BLOCKS`] that splits it into more than one tile.
-pub fn scales_of(width: u32, height: u32) -> Vec<Option<u32>> {
-    std::iter::once(None)
+pub fn scales_of(width: u32, height: u32) -> Vec<Scale> {
+    std::iter::once(Scale::Image)
         .chain(
             TILE_BLOCKS
                 .iter()
                 .filter(|&&b| b < width || b < height)
-                .map(|&b| Some(b)),
+                .map(|&b| Scale::Block(b)),
         )
         .collect()
 }
 
-/// The tile tests of `px` (row-major, `width × height`) at every scale of [`scales_of`], the
-/// family-wise [`AGGREGATE_ALPHA`] split over the scales by Šidák.
-pub(super) fn tile_tests(px: &[Pixel], width: u32, height: u32) -> Vec<ScaleTest> {
-    let scales = scales_of(width, height);
+/// The aggregate tests of `px` (row-major, `width × height`) at every scale of [`scales_of`], and
+/// per material when `materials` (a `material.Y` channel, one finite value per pixel) is given;
+/// the family-wise [`AGGREGATE_ALPHA`] is split over the scales by Šidák.
+pub(super) fn tile_tests(
+    px: &[Pixel],
+    width: u32,
+    height: u32,
+    materials: Option<&[f32]>,
+) -> Vec<ScaleTest> {
+    let materials = materials.filter(|m| m.len() == px.len() && m.iter().all(|v| v.is_finite()));
+    let mut scales = scales_of(width, height);
+    if materials.is_some() {
+        scales.push(Scale::Material);
+    }
     let alpha = sidak(AGGREGATE_ALPHA, scales.len());
+    let w = width.max(1) as usize;
     scales
         .into_iter()
-        .map(|block| scale_test(px, width, height, block, alpha))
+        .map(|scale| match (scale, materials) {
+            (Scale::Material, Some(m)) => {
+                let ids: BTreeMap<i32, usize> = m
+                    .iter()
+                    .map(|&v| v.round() as i32)
+                    .collect::<std::collections::BTreeSet<_>>()
+                    .into_iter()
+                    .enumerate()
+                    .map(|(k, id)| (id, k))
+                    .collect();
+                let by_index: Vec<i32> = ids.keys().copied().collect();
+                group_test(
+                    px,
+                    scale,
+                    alpha,
+                    ids.len(),
+                    |i| ids[&(m[i].round() as i32)],
+                    |k| Region::Material(by_index[k]),
+                )
+            }
+            _ => {
+                let (bw, bh) = match scale {
+                    Scale::Block(b) => (b.max(1), b.max(1)),
+                    _ => (width.max(1), height.max(1)),
+                };
+                let nx = width.div_ceil(bw) as usize;
+                let ny = height.div_ceil(bh) as usize;
+                group_test(
+                    px,
+                    scale,
+                    alpha,
+                    nx * ny,
+                    |i| ((i / w) as u32 / bh) as usize * nx + ((i % w) as u32 / bw) as usize,
+                    |k| {
+                        let (x, y) = ((k % nx) as u32 * bw, (k / nx) as u32 * bh);
+                        Region::Rect {
+                            x,
+                            y,
+                            width: bw.min(width - x),
+                            height: bh.min(height - y),
+                        }
+                    },
+                )
+            }
+        })
         .collect()
 }
 
-/// One scale: tiles of `block × block` pixels from the top left (the last row and column
-/// partial), or the whole image for `None`.
-fn scale_test(px: &[Pixel], width: u32, height: u32, block: Option<u32>, alpha: f64) -> ScaleTest {
-    let (bw, bh) = match block {
-        Some(b) => (b.max(1), b.max(1)),
-        None => (width.max(1), height.max(1)),
-    };
-    let (nx, ny) = (width.div_ceil(bw) as usize, height.div_ceil(bh) as usize);
-    // Per tile and channel: Σ(t − r) and Σ(var_t + var_r) over the usable pixel channels with
+/// One scale: `groups` groups, pixel `i` in group `group_of(i)`, group `k` at `region_of(k)`.
+fn group_test(
+    px: &[Pixel],
+    scale: Scale,
+    alpha: f64,
+    groups: usize,
+    group_of: impl Fn(usize) -> usize,
+    region_of: impl Fn(usize) -> Region,
+) -> ScaleTest {
+    // Per group and channel: Σ(t − r) and Σ(var_t + var_r) over the usable pixel channels with
     // variance (zero-variance channels are checked exactly per pixel; failed pixels fail there).
-    let mut sums = vec![[(0.0f64, 0.0f64); 3]; nx * ny];
+    let mut sums = vec![[(0.0f64, 0.0f64); 3]; groups];
     for (i, p) in px.iter().enumerate() {
         let Pixel::Usable { diff, var, .. } = p else {
             continue;
         };
-        let (x, y) = ((i % width as usize) as u32, (i / width as usize) as u32);
-        let tile = &mut sums[(y / bh) as usize * nx + (x / bw) as usize];
+        let g = &mut sums[group_of(i)];
         for c in 0..3 {
             if var[c] > 0.0 {
-                tile[c].0 += diff[c];
-                tile[c].1 += var[c];
+                g[c].0 += diff[c];
+                g[c].1 += var[c];
             }
         }
     }
     let tested = sums.iter().flatten().filter(|(_, v)| *v > 0.0).count();
     let z_crit = normal_quantile_two_sided(sidak(alpha, tested));
     let (mut worst, mut failed) = (None::<TileZ>, 0usize);
-    for (k, tile) in sums.iter().enumerate() {
-        for (c, &(d, v)) in tile.iter().enumerate() {
+    for (k, g) in sums.iter().enumerate() {
+        for (c, &(d, v)) in g.iter().enumerate() {
             if v <= 0.0 {
                 continue;
             }
@@ -67,12 +124,8 @@ fn scale_test(px: &[Pixel], width: u32, height: u32, block: Option<u32>, alpha: 
                 failed += 1;
             }
             if worst.as_ref().is_none_or(|w| z.abs() > w.z.abs()) {
-                let (x, y) = ((k % nx) as u32 * bw, (k / nx) as u32 * bh);
                 worst = Some(TileZ {
-                    x,
-                    y,
-                    width: bw.min(width - x),
-                    height: bh.min(height - y),
+                    region: region_of(k),
                     channel: Rgb::ALL[c],
                     z,
                 });
@@ -80,8 +133,8 @@ fn scale_test(px: &[Pixel], width: u32, height: u32, block: Option<u32>, alpha: 
         }
     }
     ScaleTest {
-        block,
-        tiles: nx * ny,
+        scale,
+        tiles: groups,
         tested,
         alpha,
         z_crit,
@@ -111,10 +164,11 @@ mod tests {
 
     #[test]
     fn scales_drop_blocks_that_cover_the_image() {
-        assert_eq!(scales_of(96, 96), vec![None, Some(32), Some(16), Some(8)]);
-        assert_eq!(scales_of(20, 12), vec![None, Some(16), Some(8)]);
-        assert_eq!(scales_of(8, 8), vec![None]);
-        assert_eq!(scales_of(40, 1), vec![None, Some(32), Some(16), Some(8)]);
+        use Scale::{Block, Image};
+        assert_eq!(scales_of(96, 96), [Image, Block(32), Block(16), Block(8)]);
+        assert_eq!(scales_of(20, 12), [Image, Block(16), Block(8)]);
+        assert_eq!(scales_of(8, 8), [Image]);
+        assert_eq!(scales_of(40, 1), [Image, Block(32), Block(16), Block(8)]);
     }
 
     #[test]
@@ -123,11 +177,14 @@ mod tests {
         // z = 240 · 0.01 / √(240 · 1e-4) = √240 ≈ 15.5 in R; G has variance but no difference,
         // B no variance (not tested).
         let px = image(20, 12, |_, _| (0.01, 1e-4));
-        let s = tile_tests(&px, 20, 12);
+        let s = tile_tests(&px, 20, 12, None);
         assert_eq!(s.len(), 3);
         let alpha = sidak(AGGREGATE_ALPHA, 3);
         let whole = &s[0];
-        assert_eq!((whole.tiles, whole.tested, whole.block), (1, 2, None));
+        assert_eq!(
+            (whole.tiles, whole.tested, whole.scale),
+            (1, 2, Scale::Image)
+        );
         assert!((whole.max_abs_z - 240f64.sqrt()).abs() < 1e-9);
         assert!((whole.alpha - alpha).abs() < 1e-15);
         assert_eq!(whole.z_crit, normal_quantile_two_sided(sidak(alpha, 2)));
@@ -136,10 +193,13 @@ mod tests {
         let w16 = &s[1];
         assert_eq!((w16.tiles, w16.tested, w16.failed), (2, 4, 2));
         let worst = w16.worst.unwrap();
-        assert_eq!(
-            (worst.x, worst.y, worst.width, worst.height),
-            (0, 0, 16, 12)
-        );
+        let rect = Region::Rect {
+            x: 0,
+            y: 0,
+            width: 16,
+            height: 12,
+        };
+        assert_eq!(worst.region, rect);
         assert_eq!(worst.channel, Rgb::R);
         assert!((worst.z - 192f64.sqrt()).abs() < 1e-9);
         // 8²: 3 × 2 tiles, the corner one 4 × 4.
@@ -150,10 +210,16 @@ mod tests {
     fn noise_passes_and_a_local_shift_fails_only_where_it_is_seen() {
         // ±1σ alternating noise passes everywhere; a +0.75σ shift of one 8×8 block (z = 6 there,
         // 3 over its 16² tile, 0.75 over the image) fails at 8² only.
-        let noise = |x: u32, y: u32| if (x + y) % 2 == 0 { 0.01 } else { -0.01 };
+        let noise = |x: u32, y: u32| {
+            if (x + y).is_multiple_of(2) {
+                0.01
+            } else {
+                -0.01
+            }
+        };
         let px = image(64, 64, |x, y| (noise(x, y), 1e-4));
         assert!(
-            tile_tests(&px, 64, 64)
+            tile_tests(&px, 64, 64, None)
                 .iter()
                 .all(|s| s.passed && s.max_abs_z < 1.0)
         );
@@ -165,11 +231,11 @@ mod tests {
             };
             (noise(x, y) + shift, 1e-4)
         });
-        let s = tile_tests(&px, 64, 64);
-        let failed: Vec<Option<u32>> = s.iter().filter(|s| !s.passed).map(|s| s.block).collect();
-        assert_eq!(failed, vec![Some(8)]);
+        let s = tile_tests(&px, 64, 64, None);
+        let failed: Vec<Scale> = s.iter().filter(|s| !s.passed).map(|s| s.scale).collect();
+        assert_eq!(failed, vec![Scale::Block(8)]);
         let worst = s[3].worst.unwrap();
-        assert_eq!((worst.x, worst.y), (8, 40));
+        assert!(matches!(worst.region, Region::Rect { x: 8, y: 40, .. }));
         assert!((worst.z - 6.0).abs() < 1e-9, "{}", worst.z);
         // Failed pixels and zero-variance channels are left out of the sums.
         let mut px = image(16, 16, |_, _| (0.0, 1e-4));
@@ -179,7 +245,44 @@ mod tests {
             var: [0.0; 3],
             exact_mismatch: true,
         };
-        let s = tile_tests(&px, 16, 16);
+        let s = tile_tests(&px, 16, 16, None);
         assert!(s.iter().all(|s| s.passed && s.max_abs_z == 0.0));
+    }
+
+    #[test]
+    fn materials_are_one_more_scale_wherever_their_pixels_are() {
+        // Material 3 on every fourth pixel of a 96 × 96 image (2304 pixels, scattered): +0.1σ
+        // there is z = 0.1 · √2304 = 4.8 over the material, but 2.4 over the whole image and
+        // 0.8 over a 32² tile (the ±1σ noise cancels over each of these groups).
+        let m: Vec<f32> = (0..96 * 96)
+            .map(|i| if i % 4 == 0 { 3.0 } else { -1.0 })
+            .collect();
+        let noise = |x: u32, y: u32| {
+            if (x + y).is_multiple_of(2) {
+                0.01
+            } else {
+                -0.01
+            }
+        };
+        let px = image(96, 96, |x, y| {
+            let shift = if x % 4 == 0 { 0.001 } else { 0.0 };
+            (noise(x, y) + shift, 1e-4)
+        });
+        let s = tile_tests(&px, 96, 96, Some(&m));
+        assert_eq!(s.len(), 5);
+        assert!((s[0].alpha - sidak(AGGREGATE_ALPHA, 5)).abs() < 1e-15);
+        let by_material = &s[4];
+        assert_eq!((by_material.scale, by_material.tiles), (Scale::Material, 2));
+        assert!(!by_material.passed);
+        let worst = by_material.worst.unwrap();
+        assert_eq!((worst.region, worst.channel), (Region::Material(3), Rgb::R));
+        assert!((worst.z - 4.8).abs() < 1e-9, "{}", worst.z);
+        assert!((s[0].max_abs_z - 2.4).abs() < 1e-9, "{}", s[0].max_abs_z);
+        assert!(s[..4].iter().all(|s| s.passed), "{s:?}");
+        // Without a usable material channel the scale is left out.
+        assert_eq!(tile_tests(&px, 96, 96, None).len(), 4);
+        let mut bad = m.clone();
+        bad[5] = f32::NAN;
+        assert_eq!(tile_tests(&px, 96, 96, Some(&bad)).len(), 4);
     }
 }

@@ -45,7 +45,8 @@ pub fn compare_with(
     let (ztest, ztest_skipped, error_map, error_scale) = match planes::pixels(&t, &r, &finite) {
         Ok((px, source)) => {
             let (mut z, map) = pixel::pixel_test(&px, source);
-            z.scales = tiles::tile_tests(&px, test.width, test.height);
+            let materials = r.material.or(t.material);
+            z.scales = tiles::tile_tests(&px, test.width, test.height, materials);
             z.passed = z.pixels_passed && z.scales.iter().all(|s| s.passed);
             let scale = z.z_crit as f32;
             (Some(z), None, map, scale)

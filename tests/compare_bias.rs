@@ -1,0 +1,277 @@
+//! `compare` detects a bias, not only noise (issue 14), on the golden scenes: the references in
+//! `tests/refs/` against test renders made as `tests/golden.rs` makes them (96×96, 256 spp,
+//! independent sampler, seed 7).
+//!
+//! - a uniform 2 % shift of every scene fails;
+//! - a 5 % shift of one material's pixels (selected by `material.Y`) fails;
+//! - a changed coat IOR (the recipe's text edited) fails;
+//! - two independent renders of every scene (seeds 7 and 8, neither the reference) pass;
+//! - over seeded pairs of independent renders, the false-failure rate is at most the stated
+//!   α = 0.01: the number of failures `f` of `n` pairs must satisfy `f ≤ k` with `k` the
+//!   smallest count for which `P(Bin(n, 0.01) > k) < 0.001`. CI runs 30 pairs at 48×48 and
+//!   128 spp; the full 200 pairs at the golden settings are `#[ignore]`d:
+//!   `cargo test --release --test compare_bias -- --ignored --nocapture`.
+
+use lapidary::image::ExrImage;
+use lapidary::image::compare::{AGGREGATE_ALPHA, Comparison, compare};
+use lapidary::image::read_exr;
+use lapidary::recipe::GemRecipe;
+use lapidary::render::{Control, Metadata, World, exr_image, render_scene};
+use lapidary::sampler::SamplerKind;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+/// The golden scenes: every reference in `tests/refs/`, sorted.
+fn scenes() -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir("tests/refs")
+        .expect("tests/refs")
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "exr"))
+        .map(|p| p.file_stem().unwrap().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert!(names.len() >= 10, "{names:?}");
+    names
+}
+
+/// The recipe a reference belongs to.
+fn recipe_of(name: &str) -> PathBuf {
+    let gem = Path::new("gems").join(format!("{name}.ron"));
+    if gem.exists() {
+        gem
+    } else {
+        Path::new("tests/scenes").join(format!("{name}.ron"))
+    }
+}
+
+fn reference(name: &str) -> ExrImage {
+    read_exr(&Path::new("tests/refs").join(format!("{name}.exr"))).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Renders `text` (recipe source, read as if it were the file `recipe`) at `size`² and `spp`
+/// with the independent sampler and `seed`, as the golden tests do.
+fn render_text(recipe: &Path, text: &str, size: u32, spp: u32, seed: u64) -> ExrImage {
+    let file = recipe.to_str().unwrap();
+    let gem = GemRecipe::parse(file, text).unwrap_or_else(|e| panic!("{e}"));
+    let mut scene = gem.compile().unwrap_or_else(|e| panic!("{e}"));
+    let r = &mut scene.stage.render;
+    (r.width, r.height, r.spp, r.seed) = (size, size, spp, seed);
+    r.sampler = SamplerKind::Independent;
+    let world = World::new(&scene).expect("world");
+    let rendered = render_scene(&world, &scene, &Control::default());
+    exr_image(&rendered, &Metadata::of(file, &scene))
+}
+
+fn render(name: &str, size: u32, spp: u32, seed: u64) -> ExrImage {
+    let recipe = recipe_of(name);
+    let text = std::fs::read_to_string(&recipe).unwrap();
+    render_text(&recipe, &text, size, spp, seed)
+}
+
+/// Every golden scene at the golden settings with seeds 7 and 8, rendered once for all tests.
+fn golden_pairs() -> &'static [(String, [ExrImage; 2])] {
+    static PAIRS: OnceLock<Vec<(String, [ExrImage; 2])>> = OnceLock::new();
+    PAIRS.get_or_init(|| {
+        scenes()
+            .into_iter()
+            .map(|n| {
+                let pair = [render(&n, 96, 256, 7), render(&n, 96, 256, 8)];
+                (n, pair)
+            })
+            .collect()
+    })
+}
+
+/// `img` with R, G, B multiplied by `gain` where `select(pixel index)` holds.
+fn shifted(img: &ExrImage, gain: f32, select: impl Fn(usize) -> bool) -> ExrImage {
+    let mut img = img.clone();
+    for c in img
+        .channels
+        .iter_mut()
+        .filter(|c| ["R", "G", "B"].contains(&&*c.name))
+    {
+        for (i, v) in c.data.iter_mut().enumerate() {
+            if select(i) {
+                *v *= gain;
+            }
+        }
+    }
+    img
+}
+
+/// One line about a comparison: pixel test and every scale.
+fn summary(c: &Comparison) -> String {
+    let z = c.ztest.as_ref().expect("the images carry variance");
+    let scales: Vec<String> = z
+        .scales
+        .iter()
+        .map(|s| {
+            let mark = if s.passed { "" } else { " FAIL" };
+            format!("{} {:.2}/{:.2}{mark}", s.label(), s.max_abs_z, s.z_crit)
+        })
+        .collect();
+    format!(
+        "pixels {:.2} %{}, tiles |z|/limit: {}",
+        100.0 * z.pass_fraction,
+        if z.pixels_passed { "" } else { " FAIL" },
+        scales.join(", ")
+    )
+}
+
+/// Whether the aggregate test failed at some scale.
+fn bias_seen(c: &Comparison) -> bool {
+    c.ztest
+        .as_ref()
+        .is_some_and(|z| z.scales.iter().any(|s| !s.passed))
+}
+
+#[test]
+fn a_uniform_two_percent_shift_fails_on_every_golden_scene() {
+    for (name, [test, _]) in golden_pairs() {
+        let reference = reference(name);
+        for gain in [1.02, 0.98] {
+            let c = compare(&shifted(test, gain, |_| true), &reference).unwrap();
+            eprintln!("{name} × {gain}: {}", summary(&c));
+            assert!(!c.passed, "{name} × {gain} passed: {}", summary(&c));
+            // The aggregate test sees it on its own, even where the pixel test does not.
+            assert!(bias_seen(&c), "{name} × {gain}: {}", summary(&c));
+        }
+    }
+}
+
+#[test]
+fn independent_renders_of_every_golden_scene_pass() {
+    for (name, [a, b]) in golden_pairs() {
+        let c = compare(a, b).unwrap();
+        eprintln!("{name}, seed 7 vs 8: {}", summary(&c));
+        assert!(c.passed, "{name}: seed 7 vs 8 failed: {}", summary(&c));
+    }
+}
+
+/// Material indices of `img` (`material.Y`) with their pixel counts, largest first.
+fn materials(img: &ExrImage) -> Vec<(i32, usize)> {
+    let mut counts = std::collections::BTreeMap::<i32, usize>::new();
+    for &m in img.channel("material.Y").unwrap() {
+        *counts.entry(m as i32).or_default() += 1;
+    }
+    let mut v: Vec<(i32, usize)> = counts.into_iter().filter(|(m, _)| *m >= 0).collect();
+    v.sort_by_key(|&(m, n)| (std::cmp::Reverse(n), m));
+    v
+}
+
+#[test]
+fn a_five_percent_shift_of_one_material_fails() {
+    // On every gem with more than one material, each material covering ≥ 2 % of the image
+    // (184 pixels) is brightened by 5 % on its own where the reference's `material.Y` names it
+    // (the labels the aggregate test groups by). The cells of an aventurine's materials are
+    // scattered over the stone, so no tile sees such a shift; the per-material groups do.
+    // (The test render's own labels agree with the reference's on only about half of an
+    // aventurine's stone pixels — the first sample's material is itself random there — so a
+    // shift selected by them is diluted; it is printed, not asserted.)
+    let mut tried = 0;
+    for (name, [test, _]) in golden_pairs() {
+        let reference = reference(name);
+        let list = materials(&reference);
+        if list.len() < 2 {
+            continue;
+        }
+        let by_ref = reference.channel("material.Y").unwrap();
+        let by_test = test.channel("material.Y").unwrap();
+        for &(m, count) in list.iter().filter(|(_, n)| *n >= 184) {
+            let c = compare(&shifted(test, 1.05, |i| by_ref[i] as i32 == m), &reference).unwrap();
+            let own =
+                compare(&shifted(test, 1.05, |i| by_test[i] as i32 == m), &reference).unwrap();
+            eprintln!(
+                "{name}, material {m} ({count} px) × 1.05: {}; selected by the test's labels: {}",
+                summary(&c),
+                if own.passed { "pass" } else { "FAIL" }
+            );
+            assert!(
+                !c.passed,
+                "{name}: material {m} × 1.05 passed: {}",
+                summary(&c)
+            );
+            tried += 1;
+        }
+    }
+    assert!(tried >= 20, "only {tried} materials tried");
+}
+
+#[test]
+fn a_changed_ior_fails() {
+    // Sunstone's coats at IOR 1.58 → 1.55 (every coat), rendered as the golden test renders.
+    let recipe = recipe_of("sunstone");
+    let text = std::fs::read_to_string(&recipe).unwrap();
+    assert!(text.contains("ior: 1.58"));
+    let changed = render_text(&recipe, &text.replace("ior: 1.58", "ior: 1.55"), 96, 256, 7);
+    let c = compare(&changed, &reference("sunstone")).unwrap();
+    eprintln!("sunstone, IOR 1.55: {}", summary(&c));
+    assert!(!c.passed, "IOR 1.55 passed: {}", summary(&c));
+    assert!(bias_seen(&c), "{}", summary(&c));
+}
+
+/// The largest failure count `k` allowed of `n` trials at false-failure rate `alpha`: the
+/// smallest `k` with `P(Bin(n, alpha) > k) < 0.001`.
+fn failure_bound(n: usize, alpha: f64) -> usize {
+    let mut pmf = (1.0 - alpha).powi(n as i32); // P(X = 0)
+    let mut cdf = pmf;
+    for k in 0..n {
+        if 1.0 - cdf < 1e-3 {
+            return k;
+        }
+        pmf *= (n - k) as f64 / (k + 1) as f64 * alpha / (1.0 - alpha);
+        cdf += pmf;
+    }
+    n
+}
+
+/// Compares `pairs` pairs of independent renders (scene `k mod 10`, seeds `100 + 2k` and
+/// `101 + 2k`) and checks the failure count against [`failure_bound`].
+fn false_failure_rate(pairs: usize, size: u32, spp: u32) {
+    let names = scenes();
+    let alpha = AGGREGATE_ALPHA;
+    let mut failures = Vec::new();
+    for k in 0..pairs {
+        let name = &names[k % names.len()];
+        let seed = 100 + 2 * k as u64;
+        let a = render(name, size, spp, seed);
+        let b = render(name, size, spp, seed + 1);
+        let c = compare(&a, &b).unwrap();
+        if !c.passed {
+            eprintln!(
+                "pair {k}: {name}, seeds {seed}/{}: {}",
+                seed + 1,
+                summary(&c)
+            );
+            failures.push(k);
+        }
+    }
+    let bound = failure_bound(pairs, alpha);
+    eprintln!(
+        "false failures: {} of {pairs} pairs ({:.2} %) at {size}×{size}, {spp} spp; stated α {alpha}; \
+         allowed ≤ {bound} (P(Bin({pairs}, {alpha}) > {bound}) < 0.001)",
+        failures.len(),
+        100.0 * failures.len() as f64 / pairs as f64
+    );
+    assert!(failures.len() <= bound, "failed pairs: {failures:?}");
+}
+
+#[test]
+fn failure_bound_is_the_binomial_tail() {
+    // P(Bin(200, 0.01) > 6) = 0.0043, > 7 = 0.0010 (just above), > 8 = 0.00024.
+    assert_eq!(failure_bound(200, 0.01), 8);
+    // P(Bin(30, 0.01) > 2) = 0.0033, > 3 = 0.00022.
+    assert_eq!(failure_bound(30, 0.01), 3);
+    assert_eq!(failure_bound(10, 0.0), 0);
+}
+
+#[test]
+fn false_failure_rate_of_independent_pairs_short() {
+    false_failure_rate(30, 48, 128);
+}
+
+#[test]
+#[ignore = "200 pairs at the golden settings: ~15 min on 2 cores"]
+fn false_failure_rate_of_independent_pairs() {
+    false_failure_rate(200, 96, 256);
+}
