@@ -15,7 +15,7 @@ fn lapidary(args: &[&str]) -> Output {
         .expect("binary runs")
 }
 
-fn text(b: &[u8]) -> String {
+fn text_of(b: &[u8]) -> String {
     String::from_utf8_lossy(b).into_owned()
 }
 
@@ -47,12 +47,12 @@ fn a_hundred_thousand_materials_check() {
     let file = dir.path("many.ron");
     std::fs::write(&file, many_materials(100_000, false)).unwrap();
     let out = lapidary(&["check", file.to_str().unwrap()]);
-    let err = text(&out.stderr);
+    let err = text_of(&out.stderr);
     assert!(out.status.success(), "{}", &err[..err.len().min(2000)]);
     assert!(
-        text(&out.stdout).contains("100000 materials"),
+        text_of(&out.stdout).contains("100000 materials"),
         "{}",
-        text(&out.stdout)
+        text_of(&out.stdout)
     );
     let warnings: Vec<&str> = err.lines().filter(|l| l.starts_with("warning:")).collect();
     assert_eq!(warnings.len(), 99_999);
@@ -63,13 +63,13 @@ fn a_hundred_thousand_materials_check() {
         "{last}"
     );
     let out = lapidary(&["info", file.to_str().unwrap()]);
-    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(out.status.success(), "{}", text_of(&out.stderr));
 
     // Every one used, through one Voronoi of 100 000 entries.
     std::fs::write(&file, many_materials(100_000, true)).unwrap();
     let out = lapidary(&["check", file.to_str().unwrap()]);
-    assert!(out.status.success(), "{}", text(&out.stderr));
-    assert!(text(&out.stdout).contains("100001 map nodes"));
+    assert!(out.status.success(), "{}", text_of(&out.stderr));
+    assert!(text_of(&out.stdout).contains("100001 map nodes"));
 }
 
 /// 100 000 unknown material names: each reported once at its own use (the first few with a
@@ -82,7 +82,7 @@ fn a_hundred_thousand_unknown_names_are_each_reported() {
     std::fs::write(&file, src).unwrap();
     let out = lapidary(&["check", file.to_str().unwrap()]);
     assert!(!out.status.success());
-    let err = text(&out.stderr);
+    let err = text_of(&out.stderr);
     let errors: Vec<&str> = err.lines().filter(|l| l.starts_with("error:")).collect();
     assert_eq!(errors.len(), 100_000, "{}", &err[..err.len().min(2000)]);
     assert!(
@@ -333,4 +333,86 @@ fn every_count_in_a_recipe_is_bounded_at_its_position() {
         ),
         "{e}"
     );
+}
+
+/// `--time-limit` covers setup: a recipe whose material tables take far longer than the limit
+/// stops while they are built, says so, and writes nothing.
+#[test]
+fn a_time_limit_that_ends_during_setup_stops_it_and_writes_nothing() {
+    let dir = Scratch::new("bounds", "setup-limit");
+    let mut text = String::from("(materials: {\n");
+    for i in 0..400 {
+        text += &format!(
+            "  \"m{i}\": (coats: [(ior: {:.4}, roughness: 5.0, thickness: 0.5), (ior: 1.6, roughness: 10.0)], base: Lambert(albedo: Gray(0.5))),\n",
+            1.3 + f64::from(i) * 0.001
+        );
+    }
+    text += "}, surface: Voronoi(scale: 0.1, entries: [";
+    for i in 0..400 {
+        text += &format!("(1.0, Material(\"m{i}\")),");
+    }
+    text += "]), stage: (lights: []))";
+    std::fs::write(dir.path("slow.ron"), text).unwrap();
+    let start = std::time::Instant::now();
+    let out = lapidary(&[
+        "render",
+        &dir.arg("slow.ron"),
+        "-o",
+        &dir.arg("slow.exr"),
+        "--size",
+        "8x8",
+        "--spp",
+        "1",
+        "--time-limit",
+        "0.5",
+    ]);
+    let err = text_of(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("stopped during setup: nothing rendered, nothing written"),
+        "{err}"
+    );
+    assert_eq!(dir.files(), ["slow.ron"]);
+    // (Building all 400 materials' tables takes tens of seconds; not asserted, just printed.)
+    println!("stopped after {:?}", start.elapsed());
+}
+
+/// A render too big for the memory allowed is refused before anything is allocated, with the
+/// figure; one that fits renders.
+#[test]
+fn a_render_needing_more_memory_than_allowed_is_refused_with_the_figure() {
+    let dir = Scratch::new("bounds", "memory");
+    std::fs::write(
+        dir.path("g.ron"),
+        "(materials: { \"a\": (base: Lambert(albedo: Gray(0.5))) }, surface: Material(\"a\"), stage: (lights: []))",
+    )
+    .unwrap();
+    let render = |extra: &[&str]| {
+        let mut args = vec!["render", "g.ron", "-o", "g.exr", "--spp", "1", "-q"];
+        args.extend_from_slice(extra);
+        Command::new(env!("CARGO_BIN_EXE_lapidary"))
+            .args(&args)
+            .current_dir(&dir.0)
+            .output()
+            .unwrap()
+    };
+    let out = render(&["--size", "16384x16384", "--max-memory", "8G"]);
+    let err = text_of(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("the render needs 68.0 GiB, 8.0 GiB allowed (film 68.0 GiB)"),
+        "{err}"
+    );
+    assert_eq!(dir.files(), ["g.ron"]);
+    let out = render(&["--size", "1024x1024", "--max-memory", "200M"]);
+    let err = text_of(&out.stderr);
+    assert!(
+        err.contains("the render needs 288.0 MiB, 200.0 MiB allowed"),
+        "{err}"
+    );
+    let out = render(&["--size", "64x64", "--max-memory", "200M"]);
+    assert!(out.status.success(), "{}", text_of(&out.stderr));
+    let out = render(&["--size", "64x64", "--max-memory", "1X"]);
+    assert!(!out.status.success());
+    assert!(text_of(&out.stderr).contains("expected a memory size"));
 }

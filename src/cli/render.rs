@@ -53,7 +53,8 @@ pub struct RenderArgs {
     /// Longest path in scattering events (default: the recipe's, else 8).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub max_depth: Option<u32>,
-    /// Stop after this many seconds and write what was rendered (marked partial).
+    /// Stop after this many seconds, setup included, and write what was rendered (marked
+    /// partial; nothing when not one pass completed).
     #[arg(long, allow_hyphen_values = true, value_parser = parse_seconds)]
     pub time_limit: Option<f64>,
     /// PNG exposure in stops (default: the recipe's, else 0).
@@ -71,6 +72,10 @@ pub struct RenderArgs {
     /// No progress bar and no summary.
     #[arg(short, long)]
     pub quiet: bool,
+    /// Refuse, before allocating, a render estimated to need more memory than this (e.g. `8G`,
+    /// `512M`; default: the memory available, else 4G).
+    #[arg(long, value_parser = crate::render::memory::parse_size)]
+    pub max_memory: Option<u64>,
 }
 
 /// `--sampler` values.
@@ -242,7 +247,29 @@ pub fn run(args: &RenderArgs) -> Result<bool> {
     args.knobs
         .apply(&mut scene)
         .map_err(|e| anyhow!("{}: {e}", args.recipe.display()))?;
-    let world = World::new(&scene).map_err(|e| anyhow!("{}: {e}", args.recipe.display()))?;
+    let limit = args
+        .max_memory
+        .unwrap_or_else(crate::render::memory::default_limit);
+    crate::render::memory::MemoryEstimate::of(&scene)
+        .check(limit)
+        .map_err(|e| anyhow!("{}: {e}", args.recipe.display()))?;
+    // The time limit covers setup too.
+    let deadline = args
+        .time_limit
+        .map(|s| Instant::now() + Duration::from_secs_f64(s));
+    let setup = crate::render::world::Setup {
+        deadline,
+        cancel: Some(cancel),
+        progress: !args.quiet,
+    };
+    let world = match World::build(&scene, &setup) {
+        Ok(w) => w,
+        Err(e @ crate::render::WorldError::Stopped) if cancel.load(Ordering::SeqCst) => {
+            eprintln!("{}: {e} (Ctrl-C or SIGTERM)", args.recipe.display());
+            return Ok(true);
+        }
+        Err(e) => bail!("{}: {e}", args.recipe.display()),
+    };
     for w in world.environment.warnings() {
         eprintln!("warning: {}: {w}", args.recipe.display());
     }
@@ -269,9 +296,7 @@ pub fn run(args: &RenderArgs) -> Result<bool> {
             StrategyArg::Light => Strategy::LightOnly,
             StrategyArg::Bsdf => Strategy::BsdfOnly,
         },
-        deadline: args
-            .time_limit
-            .map(|s| Instant::now() + Duration::from_secs_f64(s)),
+        deadline,
         cancel: Some(cancel),
         progress: Some(&progress),
         on_pass: None,

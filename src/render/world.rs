@@ -9,7 +9,10 @@ use crate::light::{Area, EnvironmentLight};
 use crate::scene::{Effect, Scene};
 use crate::texture::{Map, MapEffects};
 use glam::{Vec2, Vec3};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
 use thiserror::Error;
 
 /// Why a scene cannot be turned into a world.
@@ -29,6 +32,41 @@ pub enum WorldError {
     /// The environment map could not be read.
     #[error("environment map: {0}")]
     Environment(#[from] ImageError),
+    /// The deadline passed or the cancel flag was set before the world was built.
+    #[error("stopped during setup: nothing rendered, nothing written")]
+    Stopped,
+}
+
+/// How a world is built: when to give up, and whether to show its progress.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Setup<'a> {
+    /// Give up (with [`WorldError::Stopped`]) once this instant has passed.
+    pub deadline: Option<Instant>,
+    /// Give up once this is set (Ctrl-C).
+    pub cancel: Option<&'a AtomicBool>,
+    /// Show a progress bar on standard error (only on a terminal) once building the material
+    /// tables has taken more than [`PROGRESS_AFTER`].
+    pub progress: bool,
+}
+
+/// How long table building runs before its progress bar appears.
+pub const PROGRESS_AFTER: Duration = Duration::from_secs(1);
+
+impl Setup<'_> {
+    /// Whether to give up now.
+    fn stopped(&self) -> bool {
+        self.cancel.is_some_and(|c| c.load(Ordering::Relaxed))
+            || self.deadline.is_some_and(|d| Instant::now() >= d)
+    }
+
+    /// `Err(Stopped)` when it is time to give up.
+    fn check(&self) -> Result<(), WorldError> {
+        if self.stopped() {
+            Err(WorldError::Stopped)
+        } else {
+            Ok(())
+        }
+    }
 }
 
 /// What a ray hit first.
@@ -99,19 +137,48 @@ pub struct World {
 impl World {
     /// Builds the world for `scene` (loads the mesh and environment map, builds BSDF tables).
     pub fn new(scene: &Scene) -> Result<World, WorldError> {
+        Self::build(scene, &Setup::default())
+    }
+
+    /// [`World::new`] that gives up with [`WorldError::Stopped`] when `setup`'s deadline passes
+    /// or its cancel flag is set (checked before each material's tables and between the stages of
+    /// the build), and shows the tables' progress when they take long.
+    pub fn build(scene: &Scene, setup: &Setup) -> Result<World, WorldError> {
         let stage = &scene.stage;
+        setup.check()?;
         let stone = Stone::new(&stage.shape, stage.to_world)?;
+        setup.check()?;
         // Tables take tens of milliseconds per material: build them in parallel (the result is
-        // the same in any order).
+        // the same in any order), at most one material per task, so a stop is noticed soon.
+        let used = scene.surface.used.iter().filter(|u| **u).count() as u64;
+        let bar = ProgressBar::with_draw_target(Some(used), ProgressDrawTarget::hidden());
+        bar.set_style(
+            ProgressStyle::with_template(
+                "{spinner} [{elapsed_precise}] {wide_bar} {pos}/{len} material tables ETA {eta}",
+            )
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        );
+        let start = Instant::now();
+        let shown = AtomicBool::new(false);
         let built: Vec<Result<Option<(Bsdf, Spectrum)>, WorldError>> = scene
             .surface
             .stacks
             .par_iter()
+            .with_max_len(1)
             .enumerate()
             .map(|(k, desc)| {
                 if !scene.surface.used[k] {
                     return Ok(None);
                 }
+                setup.check()?;
+                if setup.progress
+                    && start.elapsed() > PROGRESS_AFTER
+                    && !shown.swap(true, Ordering::Relaxed)
+                {
+                    // A terminal draw target draws nothing when standard error is not a terminal.
+                    bar.set_draw_target(ProgressDrawTarget::stderr());
+                }
+                bar.inc(1);
                 let mut stack = LayeredBsdf::new(desc).map_err(|source| WorldError::Material {
                     name: scene.surface.names[k].clone(),
                     source,
@@ -122,6 +189,7 @@ impl World {
                 Ok(Some((bsdf, albedo)))
             })
             .collect();
+        bar.finish_and_clear();
         let mut materials = Vec::with_capacity(built.len());
         let mut albedo = Vec::with_capacity(built.len());
         for b in built {
@@ -140,7 +208,9 @@ impl World {
             .ground
             .map(|g| (g.height, Bsdf::Lambert(Lambert { albedo: g.albedo })));
         let areas: Vec<Area> = stage.lights.iter().map(Area::new).collect();
+        setup.check()?;
         let mut environment = EnvironmentLight::new(&stage.environment)?;
+        setup.check()?;
         if !scene.effects.on(Effect::EnvironmentImportance) {
             environment.set_importance(false);
         }
