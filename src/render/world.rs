@@ -150,8 +150,20 @@ impl World {
         setup.check()?;
         // Tables take tens of milliseconds per material: build them in parallel (the result is
         // the same in any order), at most one material per task, so a stop is noticed soon.
-        let used = scene.surface.used.iter().filter(|u| **u).count() as u64;
-        let bar = ProgressBar::with_draw_target(Some(used), ProgressDrawTarget::hidden());
+        // Materials whose stacks are identical share one build (the first of them builds).
+        let mut seen: std::collections::HashMap<String, usize> = std::collections::HashMap::new();
+        let twin: Vec<usize> = (0..scene.surface.stacks.len())
+            .map(|k| {
+                if scene.surface.used[k] {
+                    let key = format!("{:?}", scene.surface.stacks[k]);
+                    *seen.entry(key).or_insert(k)
+                } else {
+                    k
+                }
+            })
+            .collect();
+        let distinct = seen.len() as u64;
+        let bar = ProgressBar::with_draw_target(Some(distinct), ProgressDrawTarget::hidden());
         bar.set_style(
             ProgressStyle::with_template(
                 "{spinner} [{elapsed_precise}] {wide_bar} {pos}/{len} material tables ETA {eta}",
@@ -167,7 +179,7 @@ impl World {
             .with_max_len(1)
             .enumerate()
             .map(|(k, desc)| {
-                if !scene.surface.used[k] {
+                if !scene.surface.used[k] || twin[k] != k {
                     return Ok(None);
                 }
                 setup.check()?;
@@ -190,13 +202,19 @@ impl World {
             })
             .collect();
         bar.finish_and_clear();
-        let mut materials = Vec::with_capacity(built.len());
+        let mut materials: Vec<Option<Bsdf>> = Vec::with_capacity(built.len());
         let mut albedo = Vec::with_capacity(built.len());
-        for b in built {
+        for (k, b) in built.into_iter().enumerate() {
             match b? {
                 Some((bsdf, a)) => {
                     materials.push(Some(bsdf));
                     albedo.push(a);
+                }
+                // A used twin of an earlier material (built before it: `twin[k] < k`).
+                None if scene.surface.used[k] => {
+                    let first = twin[k];
+                    materials.push(materials[first].clone());
+                    albedo.push(albedo[first]);
                 }
                 None => {
                     materials.push(None);
@@ -340,4 +358,37 @@ fn normal_albedo(bsdf: &Bsdf) -> Spectrum {
         }
     }
     (sum * (1.0 / (n * n) as f32)).map(|v| v.clamp(0.0, 1.0))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::recipe::GemRecipe;
+
+    #[test]
+    fn identical_stacks_share_one_build_and_unused_ones_are_skipped() {
+        let coat = |ior: f32| {
+            format!(
+                "(coats: [(ior: {ior:?}, roughness: 5.0, thickness: 0.5)], base: Lambert(albedo: Gray(0.5)))"
+            )
+        };
+        let text = format!(
+            "(materials: {{ \"a\": {}, \"b\": {}, \"c\": {}, \"d\": {} }},\n surface: Voronoi(scale: 0.1, entries: [(1.0, Material(\"a\")), (1.0, Material(\"b\")), (1.0, Material(\"c\"))]))",
+            coat(1.5),
+            coat(1.7),
+            coat(1.5),
+            coat(1.5)
+        );
+        let scene = GemRecipe::parse("t.ron", &text).unwrap().compile().unwrap();
+        let world = World::new(&scene).unwrap();
+        let (wo, wi) = (
+            Vec3::new(0.3, 0.1, 0.9).normalize(),
+            Vec3::new(-0.2, 0.4, 0.8).normalize(),
+        );
+        let f = |k: usize| world.materials[k].as_ref().map(|b| b.eval(wo, wi));
+        assert_eq!(f(0), f(2), "a and its twin c");
+        assert_ne!(f(0), f(1));
+        assert!(f(0).is_some() && f(3).is_none(), "d is unused");
+        assert_eq!(world.albedo[0], world.albedo[2]);
+    }
 }
