@@ -1,6 +1,7 @@
 //! End-to-end tests of `lapidary compare` through the built binary: renders of a small coated
 //! scene against a high-spp reference (pass, and fail on a changed IOR or a 10 % gain), exit
-//! status 2 with a message for unusable input, the relMSE verdict without variance, the heatmap.
+//! status 2 with a message for unusable input, the relMSE verdict without variance, the heatmap;
+//! the aggregate (bias) test per scale, bad variances as unusable input, the mean ratio.
 
 use lapidary::image::{Channel, ExrImage, read_exr, write_exr};
 use std::process::{Command, Output, Stdio};
@@ -239,7 +240,16 @@ fn a_bias_within_every_pixels_noise_fails_the_aggregate_test() {
     let s = Scratch::new("cli-compare", "bias");
     s.render("ref.exr", 1.5, 256, 0);
     write_exr(&s.path("bright.exr"), &brightened(exr(&s, "ref.exr"), 1.1)).unwrap();
-    let report = status(&s.compare("bright.exr", "ref.exr", &[]), 1);
+    let out = s.compare("bright.exr", "ref.exr", &["--heatmap", "bias.png"]);
+    let report = status(&out, 1);
+    // No pixel is yellow, but the worst failing tiles are outlined in magenta.
+    let png = image::open(s.path("bias.png")).unwrap().to_rgb8();
+    let magenta = png.pixels().filter(|p| p.0 == [255, 0, 255]).count();
+    assert!(magenta >= 2 * 32 + 2 * 22, "{magenta} outline pixels");
+    assert!(
+        field(&report, "heatmap").contains("magenta = worst failing tile"),
+        "{report}"
+    );
     assert!(
         field(&report, "z-test").starts_with("100.00% of 768 pixels pass"),
         "{report}"

@@ -4,8 +4,8 @@
 //! regenerate with `scripts/update-refs`) by `lapidary::image::compare`: per pixel and channel
 //! `z = (t − r)/√(var_t + var_r)`, α = 0.01 with Šidák correction over all pixel-channels, the
 //! image passing when ≥ 99.75 % of its pixels pass (Mitsuba's practice), and by the aggregate
-//! test of the mean difference over the whole image and 32², 16², 8² tiles (α = 0.01 shared by
-//! the scales). The independent sampler keeps the test's sample variance an honest estimate of
+//! test of the mean difference over the whole image, 32², 16², 8² tiles and each material's
+//! pixels (α = 0.01 shared by the scales). The independent sampler keeps the test's sample variance an honest estimate of
 //! its error.
 //!
 //! A failure writes the test render, the reference and a heatmap under `target/golden/` and names

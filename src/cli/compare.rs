@@ -22,7 +22,8 @@ pub struct CompareArgs {
     pub test: PathBuf,
     /// The reference render (EXR; its `variance.R/G/B` enable the per-pixel z-test).
     pub reference: PathBuf,
-    /// Write a false-colour error map (viridis PNG; yellow = failing, white = NaN/∞) here.
+    /// Write a false-colour error map (viridis PNG; yellow = failing, white = NaN/∞, magenta
+    /// outline = the worst tile of a failed aggregate scale) here.
     #[arg(long, value_name = "PATH")]
     pub heatmap: Option<PathBuf>,
     /// Largest |mean_t/mean_r − 1| of a channel that passes when the z-tests cannot run (no
@@ -77,7 +78,7 @@ pub fn run(args: &CompareArgs) -> Result<Verdict> {
             None => format!("relative error ≥ {}", c.error_scale),
         };
         outln!(
-            "  heatmap   {} (viridis, yellow = {top}, white = NaN/∞)",
+            "  heatmap   {} (viridis, yellow = {top}, white = NaN/∞, magenta = worst failing tile)",
             path.display()
         );
     }
