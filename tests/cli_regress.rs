@@ -56,11 +56,14 @@ fn a_suite_passes_fails_and_reports_unusable_input() {
     );
     // Each row is followed by its per-scale verdicts; a summary closes the table.
     assert_eq!(
-        stdout.matches("    bias |z|/limit: image ").count(),
+        stdout
+            .matches("    bias (tiles) |z|/limit: image (1) ")
+            .count(),
         2,
         "{stdout}"
     );
-    assert!(stdout.contains(", 16x16 ") && stdout.contains(", 8x8 "));
+    let scales = [", 16x16 (4) ", ", 8x8 (12) ", ", material (2) "];
+    assert!(scales.iter().all(|s| stdout.contains(s)), "{stdout}");
     assert!(
         stdout.contains("summary: 2 passed, 0 failed, 0 unusable"),
         "{stdout}"
@@ -157,8 +160,11 @@ fn a_bias_below_the_pixel_noise_fails_and_the_table_says_at_which_scale() {
         stdout.contains("100.00 %"),
         "pixel test should pass: {stdout}"
     );
-    assert!(stdout.contains("    bias |z|/limit: image "), "{stdout}");
-    assert!(stdout.contains(" FAIL, 16x16"), "{stdout}");
+    assert!(
+        stdout.contains("    bias (tiles) |z|/limit: image (1) "),
+        "{stdout}"
+    );
+    assert!(stdout.contains(" FAIL, 16x16 (4) "), "{stdout}");
     assert!(
         stdout.contains("    fails: bias at image: |z| "),
         "{stdout}"

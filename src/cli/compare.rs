@@ -257,14 +257,15 @@ pub fn scale_lines(z: &ZTest) -> String {
     out
 }
 
-/// The aggregate test in one line: `label |z|/limit` per scale, failing scales marked.
+/// The aggregate test in one line: `label (groups) |z|/limit` per scale, failing ones marked.
 pub fn scale_summary(z: &ZTest) -> String {
     z.scales
         .iter()
         .map(|s| {
             format!(
-                "{} {:.2}/{:.2}{}",
+                "{} ({}) {:.2}/{:.2}{}",
                 s.label(),
+                s.tiles,
                 s.max_abs_z,
                 s.z_crit,
                 if s.passed { "" } else { " FAIL" }

@@ -246,7 +246,10 @@ pub fn run(args: &RegressArgs) -> Result<Outcome> {
         outln!("{}", row(&name, &c, args.spp, secs));
         tally.count(&c);
         match &c.ztest {
-            Some(z) => outln!("    bias |z|/limit: {}", super::compare::scale_summary(z)),
+            Some(z) => outln!(
+                "    bias (tiles) |z|/limit: {}",
+                super::compare::scale_summary(z)
+            ),
             None => outln!(
                 "    z-tests skipped ({}); mean ratio {:.4} {:.4} {:.4}",
                 c.ztest_skipped.as_deref().unwrap_or("no variance"),
