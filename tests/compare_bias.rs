@@ -271,7 +271,7 @@ fn false_failure_rate_of_independent_pairs_short() {
 }
 
 #[test]
-#[ignore = "200 pairs at the golden settings: ~15 min on 2 cores"]
+#[ignore = "200 pairs at the golden settings: ~20 min on 2 cores"]
 fn false_failure_rate_of_independent_pairs() {
     false_failure_rate(200, 96, 256);
 }
