@@ -227,9 +227,9 @@ fn settings(args: &RenderArgs, scene: &mut Scene) {
 /// Runs `lapidary render`; returns whether the render was interrupted by Ctrl-C or SIGTERM
 /// (exit 130). A render stopped by `--time-limit` before its first pass is an error (exit 1).
 pub fn run(args: &RenderArgs) -> Result<bool> {
-    // Installed first, so that a signal during setup also stops cleanly.
+    // Installed first, so that a signal during setup also stops cleanly. The flag is never
+    // reset: a signal that arrives right after the handler is installed must not be lost.
     let cancel = interrupted();
-    cancel.store(false, Ordering::SeqCst);
     let (exr_path, png_path) = outputs(args)?;
     let mut plan = OutputPlan::new();
     plan.input(&args.recipe, "the recipe")?;
