@@ -511,6 +511,18 @@ fn handler_installed(pid: u32, since: Instant) -> bool {
         .any(|t| std::fs::read_to_string(t.path().join("comm")).is_ok_and(|c| c.trim() == "ctrl-c"))
 }
 
+/// User plus system CPU time of a process in seconds (`/proc/PID/stat` fields 14 and 15, in
+/// clock ticks of 1/100 s on Linux); `None` without `/proc`.
+#[cfg(unix)]
+fn cpu_seconds(pid: u32) -> Option<f64> {
+    let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).ok()?;
+    // The command name (field 2) is in parentheses and may hold spaces: count after it.
+    let rest = &stat[stat.rfind(')')? + 2..];
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let ticks: f64 = f.get(11)?.parse::<f64>().ok()? + f.get(12)?.parse::<f64>().ok()?;
+    Some(ticks / 100.0)
+}
+
 #[cfg(unix)]
 #[test]
 fn ctrl_c_writes_a_partial_image_and_exits_130() {
@@ -534,8 +546,15 @@ fn ctrl_c_writes_a_partial_image_and_exits_130() {
         );
         std::thread::sleep(Duration::from_millis(20));
     }
-    // Let it set up (about half a second in a debug build) and render a little.
-    std::thread::sleep(Duration::from_millis(3000));
+    // Let it set up (about half a second of CPU) and render some passes (0.07 s each): wait for
+    // CPU time rather than wall time, so a loaded machine cannot make the signal land in setup.
+    while cpu_seconds(pid).is_some_and(|s| s < 3.0) {
+        assert!(
+            start.elapsed() < Duration::from_secs(120),
+            "the render used less than 3 s of CPU in 120 s"
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    }
     let kill = Command::new("kill")
         .args(["-INT", &pid.to_string()])
         .status()
