@@ -225,7 +225,7 @@ fn obj_errors_carry_the_line_number() {
         (format!("{tri}vn 0 0\nf 1 2 3\n"), "line 5:", "normal"),
         (format!("{tri}f 1 2 x\n"), "line 5:", "`x`"),
         (
-            format!("v 0 0 0\nv 1 0 0\nv 0 inf 0\n\nf 1 2 3\n"),
+            "v 0 0 0\nv 1 0 0\nv 0 inf 0\n\nf 1 2 3\n".to_string(),
             "line 3:",
             "`inf`",
         ),
