@@ -396,13 +396,18 @@ fn a_render_needing_more_memory_than_allowed_is_refused_with_the_figure() {
             .output()
             .unwrap()
     };
-    let out = render(&["--size", "16384x16384", "--max-memory", "8G"]);
+    let out = render(&["--size", "8192x8192", "--max-memory", "8G"]);
     let err = text_of(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(
-        err.contains("the render needs 68.0 GiB, 8.0 GiB allowed (film 68.0 GiB)"),
+        err.contains("the render needs 17.0 GiB, 8.0 GiB allowed (film 17.0 GiB)"),
         "{err}"
     );
+    // Beyond the largest image (2^26 pixels) the size itself is refused, with the range.
+    let out = render(&["--size", "16384x16384"]);
+    let err = text_of(&out.stderr);
+    assert!(!out.status.success());
+    assert!(err.contains("at most 67108864 pixels"), "{err}");
     assert_eq!(dir.files(), ["g.ron"]);
     let out = render(&["--size", "1024x1024", "--max-memory", "200M"]);
     let err = text_of(&out.stderr);

@@ -411,6 +411,7 @@ fn bad_arguments_name_the_allowed_values() {
     let dir = Scratch::new("cli-render", "args");
     for (args, wanted) in [
         (&["--size", "0x10"][..], "1..=16384"),
+        (&["--size", "16384x8192"], "at most 67108864 pixels"),
         (&["--size", "16385x10"], "1..=16384"),
         (&["--size", "abc"], "WxH"),
         (&["--size", "32x"], "WxH"),

@@ -129,6 +129,7 @@ fn rows() -> Vec<Row> {
         // --- Stage (numbers at the number; a tuple or colour at its closing parenthesis).
         row("spp_zero", (5, 9), &["spp = 0", "1 ..= 1048576"], stage("  render: (width: 64,\n   spp: 0),")),
         row("width_zero", (5, 11), &["image size = 0", "1 ..= 16384"], stage("  render: (spp: 4,\n   width: 0),")),
+        row("pixels_too_many", (4, 3), &["16384x8192 is 134217728 pixels", "at most 67108864"], stage("  render: (spp: 4,\n   width: 16384, height: 8192),")),
         row("fov_zero", (5, 9), &["fov = 0", "1 ..= 170"], stage("  camera: Perspective(from: (0.0, 1.0, 5.0), to: (0.0, 0.0, 0.0),\n   fov: 0.0),")),
         row("camera_inf", (5, 10), &["(0.0, inf, 5.0)", "finite"], stage("  camera: Perspective(to: (0.0, 0.0, 0.0),\n   from: (0.0, inf, 5.0)),")),
         row("camera_nan", (5, 8), &["(NaN, 0.0, 0.0)", "finite"], stage("  camera: Orthographic(from: (0.0, 1.0, 5.0), height: 2.0,\n   to: (NaN, 0.0, 0.0)),")),

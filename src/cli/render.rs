@@ -108,13 +108,22 @@ pub enum StrategyArg {
 }
 
 pub(crate) fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let err = || format!("`{s}`: expected WxH with each side in 1..=16384, e.g. 480x360");
+    use crate::scene::stage::{MAX_PIXELS, MAX_SIDE};
+    let err = || {
+        format!(
+            "`{s}`: expected WxH with each side in 1..={MAX_SIDE} and at most {MAX_PIXELS} pixels \
+             (8192x8192), e.g. 480x360"
+        )
+    };
     let (w, h) = s.split_once(['x', 'X']).ok_or_else(err)?;
     let (w, h): (u32, u32) = (
         w.trim().parse().map_err(|_| err())?,
         h.trim().parse().map_err(|_| err())?,
     );
-    if !(1..=16384).contains(&w) || !(1..=16384).contains(&h) {
+    if !(1..=MAX_SIDE).contains(&w)
+        || !(1..=MAX_SIDE).contains(&h)
+        || u64::from(w) * u64::from(h) > MAX_PIXELS
+    {
         return Err(err());
     }
     Ok((w, h))

@@ -209,6 +209,20 @@ pub(crate) fn stage(
     let rs = &mut stage.render;
     rs.width = rd.width.unwrap_or(rs.width);
     rs.height = rd.height.unwrap_or(rs.height);
+    let pixels = u64::from(rs.width) * u64::from(rs.height);
+    if pixels > crate::scene::stage::MAX_PIXELS {
+        errors.push(src.error(
+            part_at("render"),
+            format!(
+                "stage.render: {}x{} is {pixels} pixels; at most {} (8192x8192, about 18 GiB of \
+                 film) — each side 1 ..= {}",
+                rs.width,
+                rs.height,
+                crate::scene::stage::MAX_PIXELS,
+                crate::scene::stage::MAX_SIDE
+            ),
+        ));
+    }
     rs.spp = rd.spp.unwrap_or(rs.spp);
     rs.max_depth = rd.max_depth.unwrap_or(rs.max_depth);
     rs.exposure = rd.exposure.unwrap_or(rs.exposure);
