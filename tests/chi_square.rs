@@ -1,4 +1,4 @@
-//! Chi-square goodness of fit of `sample()` against `pdf()` (DESIGN §8), and the consistency of the
+//! Chi-square goodness of fit of `sample()` against `pdf()` (docs/design.md §10), and the consistency of the
 //! weight `sample()` returns with `eval()` and `pdf()`.
 //!
 //! Method (the test of Jakob's Mitsuba `ChiSquareTest`, written from its description): draw `N`

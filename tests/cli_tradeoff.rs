@@ -9,7 +9,7 @@ mod scratch;
 use scratch::{Scratch, text};
 
 /// Gold under a clear coat of IOR 1.5: the Course model lacks the 1/η² compression of the
-/// refracted lobe, so it reflects much more than the Reference walk (course §3; DESIGN §3.2).
+/// refracted lobe, so it reflects much more than the Reference walk (course §3; docs/design.md §5.2).
 const RECIPE: &str = r#"(
     materials: { "gold": (coats: [(ior: 1.5, roughness: 3.0)],
                           base: Conductor(metal: Gold, roughness: 10.0)) },

@@ -1,4 +1,4 @@
-//! White-furnace tests of the layer stack (DESIGN §3.2, §8).
+//! White-furnace tests of the layer stack (docs/design.md §5.2, §10).
 //!
 //! The directional albedo `ρ(wo) = ∫ f(wo, wi) cos θi dωi` is estimated as the mean sample weight
 //! (`measure::albedo_by_sampling`), with its standard error `σ`. A stack that only scatters and

@@ -1,4 +1,4 @@
-//! Golden renders (issue 6, DESIGN §8): every recipe in `gems/` and every analytic scene in
+//! Golden renders (issue 6, docs/design.md §10): every recipe in `gems/` and every analytic scene in
 //! `tests/scenes/` is rendered small and fast (96×96, 256 spp, independent sampler, seed 7) and
 //! z-tested against its high-spp reference in `tests/refs/` (96×96, 2048 spp, Sobol', seed 1000;
 //! regenerate with `scripts/update-refs`) by `lapidary::image::compare`: per pixel and channel

@@ -1,4 +1,4 @@
-//! Hard cases that must stay finite (DESIGN §3.3), for every component and for layer stacks under
+//! Hard cases that must stay finite (docs/design.md §5.3), for every component and for layer stacks under
 //! all three models.
 //!
 //! Two halves share one set of checkers:
@@ -12,7 +12,7 @@
 //! The same property tests with many more cases:
 //! `cargo test --release --test hard_cases -- --ignored`
 //!
-//! Properties (DESIGN §2, §3.3; `src/bsdf/mod.rs`):
+//! Properties (docs/design.md §4, §5.3; `src/bsdf/mod.rs`):
 //! - `eval` finite and non-negative per channel; `pdf` finite and `≥ 0`;
 //! - `sample` is `None` or has a unit `wi`, a finite `pdf > 0`, a finite non-negative `f` and
 //!   `weight`, `weight == f·|cos θi|/pdf`, `pdf(wo, wi) > 0`, and (exact-pdf models: components,

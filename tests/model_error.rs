@@ -1,5 +1,5 @@
 //! The analytic layer models (Course, Corrected) against the stochastic Reference walk, per
-//! catalogue material (DESIGN §3.2, §7).
+//! catalogue material (docs/design.md §5.2, §9).
 //!
 //! Error over a grid of direction pairs (θo, θi ∈ {10, 30, 50, 70, 85}°, Δφ ∈ {0, 90, 180}°, 75
 //! ordered pairs), on luminance:

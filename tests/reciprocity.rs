@@ -1,4 +1,4 @@
-//! Helmholtz reciprocity (DESIGN §8).
+//! Helmholtz reciprocity (docs/design.md §10).
 //!
 //! Every component must satisfy `f(wo, wi) = f(wi, wo)` up to `f32` rounding; transmission through
 //! a dielectric in radiance mode satisfies the generalised relation `f(wo, wi)/η(wo)² =
@@ -7,7 +7,7 @@
 //!
 //! The layer stack is not exactly reciprocal: the Corrected model's multiple-reflection lobe
 //! `q(wo)·T(wi)` and the conductors' energy compensation depend on `wo` differently than on `wi`
-//! (DESIGN §3.2 asks to measure and report by how much), and the Course model's `t` term (eq. 3.3)
+//! (docs/design.md §5.2 asks to measure and report by how much), and the Course model's `t` term (eq. 3.3)
 //! uses `T21(wo)` only. The asymmetry is measured per catalogue material and model, printed, and
 //! bounded slightly above today's values so that a regression fails. The Reference walk is
 //! stochastic: its asymmetry is compared with its own noise floor, the same measure between two

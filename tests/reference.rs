@@ -1,4 +1,4 @@
-//! The Reference model (position-free random walk, Guo et al. 2018; DESIGN §3.2): its `sample`
+//! The Reference model (position-free random walk, Guo et al. 2018; docs/design.md §5.2): its `sample`
 //! and its `eval` are two independent estimators of the same BSDF and must agree in the mean; its
 //! `eval` is repeatable and seeded by the directions; huge absorption leaves only the top
 //! interface's reflection.

@@ -14,7 +14,7 @@
 //! `F · G / G1 ≤ 1` — no heavy tails, also at grazing angles.
 //! Near-mirror roughness (m = 0.01°, `e ≈ 6.6e7`) is handled by never forming `cos θh` from a
 //! difference: `cos^e θh = exp(e/2 · ln(1 − sin²θh))` with `sin²θh = hx² + hy²`, and the sampler
-//! inverts the CDF with `expm1`/`ln_1p` (DESIGN §3.3).
+//! inverts the CDF with `expm1`/`ln_1p` (docs/design.md §5.3).
 
 use glam::{Vec2, Vec3};
 use serde::{Deserialize, Serialize};

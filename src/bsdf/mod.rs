@@ -1,6 +1,6 @@
 //! BSDFs: the components of the course's layered model and the layer stack itself.
 //!
-//! # Conventions (written once, here; DESIGN §2)
+//! # Conventions (written once, here; docs/design.md §4)
 //!
 //! - Directions are unit vectors in the **local shading frame**: `z` is the shading normal and
 //!   `cos θ(w) = w.z`. Nothing in this module knows about world space.
@@ -19,7 +19,7 @@
 //! - Oren–Nayar `σ` is in radians. IORs are absolute in descriptions and relative (below / above) at
 //!   an interface. Colours are linear Rec.709 [`Spectrum`]s.
 //! - Every result is finite and non-negative for every input the types allow, including grazing
-//!   `cos θ` down to 1e-7, `wo == wi`, `wo == -wi` and `u` exactly 0 or 1 (DESIGN §3.3); whenever
+//!   `cos θ` down to 1e-7, `wo == wi`, `wo == -wi` and `u` exactly 0 or 1 (docs/design.md §5.3); whenever
 //!   `f > 0` for a direction that `sample` can produce, its `pdf > 0`.
 
 pub mod dielectric;

@@ -1,5 +1,5 @@
 //! `lapidary compare TEST.exr REF.exr [--heatmap diff.png]`: regression check of a render against
-//! a reference (DESIGN §8). Prints one line per metric and a verdict; the rules are those of
+//! a reference (docs/design.md §10). Prints one line per metric and a verdict; the rules are those of
 //! [`mod@crate::image::compare`]: the per-pixel z-test, the aggregate test at each tile scale
 //! (one line per scale: tiles, largest |z|, limit, verdict) and the mean ratio. Exit status: 0
 //! pass, 1 fail, 2 unusable input (a missing or unreadable file, sizes that differ, a missing

@@ -1,4 +1,4 @@
-//! `lapidary tradeoff RECIPE`: what accuracy costs in time (DESIGN §7). It renders a converged
+//! `lapidary tradeoff RECIPE`: what accuracy costs in time (docs/design.md §9). It renders a converged
 //! reference (Reference model, exact Fresnel, deep paths, many samples; cached in the output
 //! folder), then renders the recipe once per knob setting for a fixed time budget, capturing the
 //! film at every power-of-two spp ([`crate::render::study`]). For each setting it reports the

@@ -436,7 +436,7 @@ pub struct RenderDesc {
     /// Seed of the pixel samples, 0 ..= 2⁶⁴ − 1 (not of the maps: that is the recipe's `seed`).
     #[serde(default, deserialize_with = "seed_range")]
     pub seed: Option<u64>,
-    /// Accuracy knobs for every material and forced effects (DESIGN §7).
+    /// Accuracy knobs for every material and forced effects (docs/design.md §9).
     #[serde(default)]
     pub accuracy: Option<AccuracyDesc>,
 }

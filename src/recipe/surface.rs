@@ -1,4 +1,4 @@
-//! Serde description of a gem's surface: the map tree and its fields (DESIGN §4), separate from the
+//! Serde description of a gem's surface: the map tree and its fields (docs/design.md §6), separate from the
 //! runtime [`crate::texture::Map`] it compiles into.
 //!
 //! ```ron

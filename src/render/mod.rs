@@ -1,4 +1,4 @@
-//! The path tracer (DESIGN §6): camera rays, pixel filters, the integrator, the film, and the
+//! The path tracer (docs/design.md §8): camera rays, pixel filters, the integrator, the film, and the
 //! loop that renders a compiled [`Scene`](crate::scene::Scene) in passes of samples over tiles, in parallel.
 //!
 //! **Determinism.** Every random number is `hash(seed, pixel, sample, slot)` ([`PixelSampler`]);

@@ -1,4 +1,4 @@
-//! The EXR a render writes: colour, AOVs and metadata (DESIGN §6).
+//! The EXR a render writes: colour, AOVs and metadata (docs/design.md §8).
 //!
 //! Channels (all 32-bit float, one part):
 //!

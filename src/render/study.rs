@@ -1,4 +1,4 @@
-//! Convergence studies for `lapidary tradeoff` (DESIGN §7). One render per setting runs until a
+//! Convergence studies for `lapidary tradeoff` (docs/design.md §9). One render per setting runs until a
 //! time budget; the film is captured after every pass of samples ([`Control::on_pass`]), and a
 //! capture after `n` spp equals a render of `n` spp bit for bit. So one run gives the error at
 //! every power-of-two spp (equal-spp comparisons and the error-against-time curve) and at the

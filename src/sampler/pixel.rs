@@ -1,6 +1,6 @@
 //! The per-pixel sample generator of the renderer: every number is a pure function of
 //! `(seed, pixel, sample index, dimension)`, so a render is bit-identical for any thread count and
-//! any order of tiles (DESIGN §6).
+//! any order of tiles (docs/design.md §8).
 
 use super::sobol::{fixed_to_unit, scrambled_pair};
 use super::{mix64, to_unit_f32};

@@ -1,4 +1,4 @@
-//! Accuracy knobs (DESIGN §7): every approximation and optional effect of a render, settable from
+//! Accuracy knobs (docs/design.md §9): every approximation and optional effect of a render, settable from
 //! the command line (`lapidary render --model course --bump off …`), from a recipe
 //! (`render: (accuracy: (…))`) and by `lapidary tradeoff --setting …`.
 //!

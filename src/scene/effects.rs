@@ -1,5 +1,5 @@
 //! The effects set: which optional parts of the simulation a compiled scene needs, and which
-//! recipe element turned each one on (DESIGN §5). The renderer tests a bit per effect and skips the
+//! recipe element turned each one on (docs/design.md §7). The renderer tests a bit per effect and skips the
 //! work of every effect that is off; `lapidary info` prints the reasons.
 
 use std::fmt;

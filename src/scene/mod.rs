@@ -1,4 +1,4 @@
-//! Runtime scene data compiled from a recipe (DESIGN §5): flat arrays indexed by integers, no
+//! Runtime scene data compiled from a recipe (docs/design.md §7): flat arrays indexed by integers, no
 //! names or hash maps on the hot path, kept apart from the serde description in [`crate::recipe`].
 //!
 //! A [`Scene`] is the gem's [`Surface`] (material table and map tree), the resolved [`Stage`]

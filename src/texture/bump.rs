@@ -6,7 +6,7 @@
 //! - `Cone { half_angle }`: uniform over the solid angle of the cone `θ ≤ half_angle`:
 //!   `cos θ = 1 − u₁(1 − cos θmax)`, `φ = 2πu₂`; pdf `1 / (2π(1 − cos θmax))` per steradian.
 //! - `Beckmann { rms }`: the Beckmann slope distribution with `α = tan(rms)` (the course's roughness
-//!   convention: `rms` is the RMS slope angle; DESIGN §2): `tan²θ = −α² ln(1 − u₁)`, `φ = 2πu₂`;
+//!   convention: `rms` is the RMS slope angle; docs/design.md §4): `tan²θ = −α² ln(1 − u₁)`, `φ = 2πu₂`;
 //!   pdf `exp(−tan²θ/α²) / (π α² cos³θ)` per steradian (the microfacet `D(n) cos θ`).
 //!
 //! **The rule for facets that turn away from the viewer.** A tilted facet can face away from `wo`

@@ -4,7 +4,7 @@
 //! tree cannot have cycles); entries, stops and fields live in their own flat arrays. A lookup walks
 //! indices on the stack: no allocation, no strings, no hashing of names.
 //!
-//! Semantics (DESIGN §4, course §5.2.1, fig. 5.2):
+//! Semantics (docs/design.md §6, course §5.2.1, fig. 5.2):
 //! - `Material(m)`: material index `m` everywhere.
 //! - `Voronoi`: the point's cell (nearest feature point at `p / scale`) is *filled* with probability
 //!   `fill` and, if filled, picks entry `k` with probability `weightₖ / Σ weight` — both decided by

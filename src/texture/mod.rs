@@ -1,4 +1,4 @@
-//! Procedural solid textures over object-space positions (course §5.2.1; DESIGN §4).
+//! Procedural solid textures over object-space positions (course §5.2.1; docs/design.md §6).
 //!
 //! - [`voronoi`]: the exact, seedable cellular basis (F1, F2, edge distance, 64-bit cell ids).
 //! - [`perlin`](mod@perlin): hashed-lattice gradient noise, fBm and turbulence.

@@ -1,4 +1,4 @@
-//! Map trees with effects switched off, for the accuracy knobs (DESIGN §7): the glitter overlay,
+//! Map trees with effects switched off, for the accuracy knobs (docs/design.md §9): the glitter overlay,
 //! the stochastic switch bands and the facet bump. The rewrite happens once, when the world is
 //! built, so a switched-off effect costs nothing per lookup.
 

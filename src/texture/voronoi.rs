@@ -11,7 +11,7 @@
 //! whole shells of cells at Chebyshev distance 2, 3, … while a shell could still hold a closer
 //! point (for F1, F2) or a closer bisector (a point `pj` can only matter if
 //! `|x − pj| < F1 + 2·edge`). The `noise` crate's Worley was not used: it offers 256 cell values,
-//! no F2 or edge distance, an incomplete neighbourhood and is `!Send` (DESIGN §4).
+//! no F2 or edge distance, an incomplete neighbourhood and is `!Send` (docs/design.md §6).
 //!
 //! Cells a point cannot reach are culled by their box distance before they are hashed, so a typical
 //! lookup hashes 8–15 of the 27 neighbours; [`Voronoi::nearest`] (F1 and the id only) stops as soon

@@ -71,7 +71,7 @@ fn expand(list: Vec<(String, SharedBxdf, bool)>) -> Vec<Subject> {
     out
 }
 
-/// The components (DESIGN §3.1) with the parameters of the issue. The flag says whether `wo`
+/// The components (docs/design.md §5.1) with the parameters of the issue. The flag says whether `wo`
 /// below the surface is tested too (only the rough dielectric scatters from there).
 pub fn component_bsdfs() -> Vec<(String, SharedBxdf, bool)> {
     let ts = |kind, m, fresnel: Fresnel| {

@@ -1,4 +1,4 @@
-//! Statistical and robustness tests of the texture maps (`lapidary::texture`, DESIGN §4): Voronoi
+//! Statistical and robustness tests of the texture maps (`lapidary::texture`, docs/design.md §6): Voronoi
 //! entry and fill frequencies, facet-tilt distributions, the geometry of the cellular basis,
 //! determinism across threads, seed decorrelation, finiteness at awkward coordinates, switch blend
 //! bands and the energy of the rule for facets seen from behind.

@@ -10,7 +10,7 @@
 //! coat's internal diffuse reflectance. With a white Lambert base and no absorption this gives
 //! albedo exactly `E_top + T = 1` (up to the tables' quadrature error).
 //!
-//! DESIGN §3.2 writes the lobe as `q(wo) · ρ̄/(1 − ρ̄ r_int) · T(wi)/(π η²)`: trapped energy that
+//! docs/design.md §5.2 writes the lobe as `q(wo) · ρ̄/(1 − ρ̄ r_int) · T(wi)/(π η²)`: trapped energy that
 //! leaves with the distribution of diffuse inner light. Its albedo is `M q(wo)`, but it is not
 //! reciprocal when `Q` varies with the angle (glossy bases). The form used here has the same
 //! albedo `M q(wo)` for every `wo` (so the furnace property is unchanged), is symmetric in `wo`,

@@ -1,4 +1,4 @@
-//! The Weidlich–Wilkie layer stack (course §3.1–3.2; DESIGN §3.2): rough dielectric coats with
+//! The Weidlich–Wilkie layer stack (course §3.1–3.2; docs/design.md §5.2): rough dielectric coats with
 //! absorbing varnish over one opaque base, evaluated by one of three [`Model`]s.
 //!
 //! - [`Model::Course`] — eqs. 3.1–3.3 exactly as published ([`course`]).
@@ -102,7 +102,7 @@ impl Default for ReferenceParams {
     }
 }
 
-/// Which evaluation model a stack uses (DESIGN §3.2).
+/// Which evaluation model a stack uses (docs/design.md §5.2).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Model {
     /// Course eqs. 3.1–3.3 as published.

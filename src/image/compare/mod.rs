@@ -1,4 +1,4 @@
-//! Comparing a test render with a reference render (DESIGN §8): error metrics, a per-pixel
+//! Comparing a test render with a reference render (docs/design.md §10): error metrics, a per-pixel
 //! z-test, an aggregate (bias) test over tiles, a mean ratio, a verdict, and a false-colour
 //! error map.
 //!
