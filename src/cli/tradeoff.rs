@@ -8,8 +8,11 @@
 //! one series per setting).
 
 mod csv;
+pub mod row;
 
 use self::csv::{curves_csv, summary_csv, write_csv};
+pub use self::row::Row;
+use self::row::at_spp;
 use super::knobs::KnobArgs;
 use super::render::parse_size;
 use crate::image::atomic::all_or_nothing;
@@ -99,25 +102,6 @@ fn parse_spp(s: &str) -> Result<u32, String> {
         Ok(v) if (4..=1 << 20).contains(&v) && v.is_power_of_two() => Ok(v),
         _ => Err(format!("`{s}`: expected a power of two in 4..=1048576")),
     }
-}
-
-/// One studied setting and its measurements.
-#[derive(Clone, Debug)]
-pub struct Row {
-    /// The setting as written.
-    pub label: String,
-    /// Seconds to build the world (material tables).
-    pub setup: f64,
-    /// Paths per second over the whole render.
-    pub paths_per_second: f64,
-    /// Each capture's spp, seconds and errors.
-    pub curve: Vec<(u32, f64, Errors)>,
-    /// The equal-time capture.
-    pub last: Option<(u32, f64, Errors)>,
-    /// The relMSE left with infinitely many samples: the intercept `b` of a least-squares fit
-    /// `relMSE ≈ a / spp + b` over the captures from 16 spp (the bias of an approximation; ≈ 0
-    /// for an unbiased setting).
-    pub bias: Option<f64>,
 }
 
 /// Least-squares intercept of `y = a x + b` over `(x, y)`; `None` for fewer than 3 points.
@@ -222,7 +206,7 @@ pub fn run(args: &TradeoffArgs) -> Result<()> {
     out!("{table}");
     // The three files together or none of them.
     all_or_nothing(|| {
-        write_csv(&csv_path, &summary_csv(args, &rows))?;
+        write_csv(&csv_path, &summary_csv(args.spp, args.budget, &rows))?;
         write_csv(&curves_path, &curves_csv(&rows))?;
         super::tradeoff_plot::plot(&name, &rows, reference.noise_floor(), &plot)
     })?;
@@ -358,13 +342,6 @@ fn measure(label: &str, setup: f64, conv: &Convergence, reference: &Reference) -
         curve,
         last,
     }
-}
-
-fn at_spp(row: &Row, spp: u32) -> Option<(f64, Errors)> {
-    row.curve
-        .iter()
-        .find(|(s, _, _)| *s == spp)
-        .map(|&(_, t, e)| (t, e))
 }
 
 fn cell(v: Option<f64>, fmt: fn(f64) -> String) -> String {

@@ -4,7 +4,7 @@
 //! until it meets the floor.
 
 use super::plot::{register_font, save_png};
-use super::tradeoff::Row;
+use super::tradeoff::row::Row;
 use anyhow::{Result, anyhow};
 use plotters::prelude::*;
 use std::path::Path;

@@ -5,8 +5,8 @@
 //! and accepting points inside its boundary. There is no acceptance test at the rim to fail by
 //! rounding, so rays aimed at the rim cannot slip between the dome and the base.
 
+use super::hit::{GeometryError, ShapeHit, first_of_interval, valid_query};
 use super::ray::Ray;
-use super::solid::{GeometryError, ShapeHit, first_of_interval, valid_query};
 use super::sphere::sphere_interval;
 use glam::Vec3;
 

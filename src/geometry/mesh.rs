@@ -1,8 +1,8 @@
 //! Triangle meshes loaded from OBJ files, indexed by a BVH (obvhs) and intersected with the
 //! watertight ray/triangle test.
 
+use super::hit::{GeometryError, ShapeHit, valid_query};
 use super::ray::Ray;
-use super::solid::{GeometryError, ShapeHit, valid_query};
 use glam::Vec3;
 use obvhs::{BvhBuildParams, aabb::Aabb, bvh2::Bvh2, bvh2::builder::build_bvh2, ray::RayHit};
 use std::path::Path;

@@ -6,8 +6,10 @@
 
 pub mod cabochon;
 pub mod frame;
+pub mod hit;
 pub mod mesh;
 pub mod ray;
+pub mod shape;
 pub mod slab;
 pub mod solid;
 pub mod sphere;
@@ -15,9 +17,11 @@ pub mod stone;
 
 pub use cabochon::Cabochon;
 pub use frame::Frame;
+pub use hit::{GeometryError, ShapeHit};
 pub use mesh::Mesh;
 pub use ray::{Ray, offset_origin};
+pub use shape::Shape;
 pub use slab::Slab;
-pub use solid::{GeometryError, ShapeHit, Solid};
+pub use solid::Solid;
 pub use sphere::Sphere;
 pub use stone::{Stone, StoneHit};

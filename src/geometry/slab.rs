@@ -1,7 +1,7 @@
 //! The slab: an axis-aligned box centred on the y axis, resting on y = 0.
 
+use super::hit::{GeometryError, ShapeHit, first_of_interval, valid_query};
 use super::ray::Ray;
-use super::solid::{GeometryError, ShapeHit, first_of_interval, valid_query};
 use glam::Vec3;
 
 /// The box `[−sx/2, sx/2] × [0, sy] × [−sz/2, sz/2]` in object space (object units).
@@ -189,7 +189,7 @@ mod tests {
     fn cube_mesh_matches_slab() {
         let manifest = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
         let path = manifest.join("tests/data/cube.obj");
-        let cube = Solid::new(&crate::scene::stage::Shape::Mesh { path, scale: 0.5 }).unwrap();
+        let cube = Solid::new(&crate::geometry::shape::Shape::Mesh { path, scale: 0.5 }).unwrap();
         let slab = Solid::Slab(Slab::new(Vec3::ONE).unwrap());
         assert_eq!(cube.triangles(), 12);
         assert_eq!(cube.bounds(), slab.bounds());

@@ -1,8 +1,8 @@
 //! A sphere centred at the origin, and the numerically careful ray/sphere interval shared with the
 //! cabochon's ellipsoids.
 
+use super::hit::{GeometryError, ShapeHit, first_of_interval, valid_query};
 use super::ray::Ray;
-use super::solid::{GeometryError, ShapeHit, first_of_interval, valid_query};
 use glam::Vec3;
 
 /// The parameters `t0 ≤ t1` where the line `o + t·d` crosses the sphere `|p| = r` centred at the

@@ -1,8 +1,9 @@
 //! The stone: its solid placed in the world by an affine transform.
 
+use super::hit::GeometryError;
 use super::ray::Ray;
-use super::solid::{GeometryError, Solid};
-use crate::scene::stage::Shape;
+use super::shape::Shape;
+use super::solid::Solid;
 use glam::{Affine3A, Mat3A, Vec3};
 
 /// A ray/stone intersection in world space.

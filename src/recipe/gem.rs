@@ -38,12 +38,10 @@
 //! # Ok::<(), lapidary::recipe::RecipeError>(())
 //! ```
 
-use super::compile::Compiler;
 use super::source::Source;
 use super::stage::StageDesc;
 use super::surface::MapDesc;
 use super::{MaterialDesc, MaterialLibrary, RecipeError};
-use crate::scene::Scene;
 use indexmap::IndexMap;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -82,18 +80,6 @@ pub struct GemRecipe {
     pub library: MaterialLibrary,
 }
 
-/// Everything `lapidary check` learns about a file: every error found, warnings, and the compiled
-/// scene when there were no errors.
-#[derive(Debug, Default)]
-pub struct Report {
-    /// Errors, in the order found.
-    pub errors: Vec<RecipeError>,
-    /// Things that are allowed but probably unintended (unused materials).
-    pub warnings: Vec<RecipeError>,
-    /// The compiled scene (when `errors` is empty).
-    pub scene: Option<Scene>,
-}
-
 impl GemRecipe {
     /// Reads and parses a recipe file and its includes (materials validated, tree not yet
     /// compiled); the first error, if any.
@@ -108,7 +94,7 @@ impl GemRecipe {
     }
 
     /// Parses and resolves includes, collecting every error.
-    fn read(source: Source, path: Option<&Path>) -> (Option<Self>, Vec<RecipeError>) {
+    pub(super) fn read(source: Source, path: Option<&Path>) -> (Option<Self>, Vec<RecipeError>) {
         let mut errors = vec![];
         let content: GemDesc = match super::ranged::parse(&source) {
             Ok(c) => c,
@@ -131,37 +117,6 @@ impl GemRecipe {
         (Some(recipe), errors)
     }
 
-    /// Checks a file completely: syntax, includes, every material, the whole tree, the stage;
-    /// reports every error it can find (the parser stops at its first error; everything after
-    /// parsing is checked in full).
-    pub fn check(path: &Path) -> Report {
-        match Source::read(path) {
-            Ok(source) => Self::check_source(source, Some(path)),
-            Err(e) => Report {
-                errors: vec![e],
-                ..Report::default()
-            },
-        }
-    }
-
-    /// [`GemRecipe::check`] over text already in memory.
-    pub fn check_source(source: Source, path: Option<&Path>) -> Report {
-        let (recipe, mut errors) = Self::read(source, path);
-        let Some(recipe) = recipe else {
-            return Report {
-                errors,
-                ..Report::default()
-            };
-        };
-        let mut warnings = vec![];
-        let scene = recipe.compile_into(&mut errors, &mut warnings);
-        Report {
-            scene: if errors.is_empty() { scene } else { None },
-            errors,
-            warnings,
-        }
-    }
-
     /// The file name used in messages.
     pub fn file(&self) -> &str {
         &self.source.file
@@ -174,33 +129,6 @@ impl GemRecipe {
             .and_then(Path::parent)
             .map(Path::to_path_buf)
             .unwrap_or_default()
-    }
-
-    /// Compiles materials, map tree, stage and effects into a runtime scene; the first error.
-    pub fn compile(&self) -> Result<Scene, RecipeError> {
-        let mut errors = vec![];
-        let scene = self.compile_into(&mut errors, &mut vec![]);
-        match errors.into_iter().next() {
-            Some(e) => Err(e),
-            None => Ok(scene.expect("no errors means a scene")),
-        }
-    }
-
-    fn compile_into(
-        &self,
-        errors: &mut Vec<RecipeError>,
-        warnings: &mut Vec<RecipeError>,
-    ) -> Option<Scene> {
-        let scene = Compiler::new(self).run(errors, warnings);
-        if let Some(scene) = &scene {
-            for name in scene.surface.unused() {
-                warnings.push(self.source.error(
-                    self.source.key(name),
-                    format!("material \"{name}\" is defined but the surface never uses it"),
-                ));
-            }
-        }
-        scene
     }
 }
 

@@ -12,12 +12,14 @@ pub mod color;
 mod compile;
 pub mod gem;
 pub mod library;
+mod map_compiler;
 pub mod material;
 mod resolve;
 pub mod source;
 pub mod stage;
 pub mod surface;
 
+pub use compile::Report;
 pub use gem::{GemDesc, GemRecipe};
 pub use library::{COURSE_CATALOGUE, MaterialFile, MaterialLibrary};
 pub use material::{BaseDesc, CoatDesc, MaterialDesc, MetalDesc, ModelDesc};

@@ -1,12 +1,12 @@
 //! The two CSV files of `lapidary tradeoff`: a row per setting (`tradeoff.csv`) and a row per
 //! capture (`tradeoff-curves.csv`).
 
-use super::{Row, TradeoffArgs, at_spp};
+use super::row::{Row, at_spp};
 use anyhow::{Context, Result};
 use std::fmt::Write as _;
 use std::path::Path;
 
-pub(super) fn summary_csv(args: &TradeoffArgs, rows: &[Row]) -> String {
+pub(super) fn summary_csv(spp: u32, budget: f64, rows: &[Row]) -> String {
     let mut o = String::from(
         "setting,setup_s,paths_per_s,equal_spp,equal_spp_time_s,equal_spp_relmse,\
          equal_spp_relmse_raw,equal_spp_flip,equal_spp_energy,equal_time_budget_s,equal_time_spp,\
@@ -18,20 +18,20 @@ pub(super) fn summary_csv(args: &TradeoffArgs, rows: &[Row]) -> String {
             .map_or(String::new(), |v| format!("{v:.6e}"))
     };
     for r in rows {
-        let eq = at_spp(r, args.spp);
+        let eq = at_spp(r, spp);
         let _ = writeln!(
             o,
             "\"{}\",{:.4},{:.0},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             r.label,
             r.setup,
             r.paths_per_second,
-            args.spp,
+            spp,
             num(eq.map(|e| e.0)),
             num(eq.map(|e| e.1.rel_mse)),
             num(eq.map(|e| e.1.rel_mse_raw)),
             num(eq.map(|e| e.1.flip)),
             num(eq.map(|e| e.1.stone_ratio)),
-            args.budget,
+            budget,
             r.last.map_or(String::new(), |l| l.0.to_string()),
             num(r.last.map(|l| l.1)),
             num(r.last.map(|l| l.2.rel_mse)),
