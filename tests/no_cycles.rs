@@ -61,7 +61,10 @@ fn collect(dir: &Path, prefix: &[String], out: &mut BTreeMap<Module, (PathBuf, S
                     (p, false)
                 }
             };
-            out.insert(Module(segments), (path.clone(), production_code(&text), face));
+            out.insert(
+                Module(segments),
+                (path.clone(), production_code(&text), face),
+            );
         }
     }
 }
@@ -494,5 +497,8 @@ fn the_checker_sees_a_cycle() {
     let code = production_code("use x::y; // crate::z\nfn f() { crate::q::R::new(\"crate::s\") }");
     let p = named_paths(&code);
     assert!(p.contains(&vec!["crate".into(), "q".into(), "R".into(), "new".into()]));
-    assert!(!p.iter().any(|p| p.contains(&"z".to_string()) || p.contains(&"s".to_string())));
+    assert!(
+        !p.iter()
+            .any(|p| p.contains(&"z".to_string()) || p.contains(&"s".to_string()))
+    );
 }
