@@ -4,7 +4,7 @@
 
 #[path = "common/scratch.rs"]
 mod scratch;
-use scratch::{Scratch, text};
+use scratch::{Scratch, handler_installed, text};
 #[path = "common/outputs.rs"]
 mod run;
 use run::{LONG, SUNSTONE, lapidary, refused};
@@ -12,18 +12,6 @@ use run::{LONG, SUNSTONE, lapidary, refused};
 use std::process::{Child, Command, Stdio};
 #[cfg(unix)]
 use std::time::{Duration, Instant};
-
-/// Whether the process has installed its signal handler (the `ctrlc` crate runs it on a thread
-/// named `ctrl-c`). Without `/proc`, assume so after a while.
-#[cfg(unix)]
-fn handler_installed(pid: u32, since: Instant) -> bool {
-    let Ok(tasks) = std::fs::read_dir(format!("/proc/{pid}/task")) else {
-        return since.elapsed() > Duration::from_secs(3);
-    };
-    tasks
-        .filter_map(Result::ok)
-        .any(|t| std::fs::read_to_string(t.path().join("comm")).is_ok_and(|c| c.trim() == "ctrl-c"))
-}
 
 /// Starts `lapidary render SUNSTONE -o out.exr LONG` in `s` and waits for its signal handler.
 #[cfg(unix)]

@@ -7,7 +7,7 @@ use std::process::{Command, Output, Stdio};
 
 #[path = "common/scratch.rs"]
 mod scratch;
-use scratch::{Scratch, text};
+use scratch::{Scratch, handler_installed, text};
 use std::time::{Duration, Instant};
 
 const SUNSTONE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/gems/sunstone.ron");
@@ -498,18 +498,6 @@ fn time_limit_stops_early_and_writes_a_partial_image() {
             "{name} has non-finite values"
         );
     }
-}
-
-/// Whether the process has installed its Ctrl-C handler, i.e. is about to render (the `ctrlc`
-/// crate runs the handler on a thread named `ctrl-c`). Without `/proc`, assume so after a while.
-#[cfg(unix)]
-fn handler_installed(pid: u32, since: Instant) -> bool {
-    let Ok(tasks) = std::fs::read_dir(format!("/proc/{pid}/task")) else {
-        return since.elapsed() > Duration::from_secs(3);
-    };
-    tasks
-        .filter_map(Result::ok)
-        .any(|t| std::fs::read_to_string(t.path().join("comm")).is_ok_and(|c| c.trim() == "ctrl-c"))
 }
 
 /// User plus system CPU time of a process in seconds (`/proc/PID/stat` fields 14 and 15, in

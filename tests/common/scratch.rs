@@ -53,3 +53,15 @@ impl Drop for Scratch {
 pub fn text(b: &[u8]) -> String {
     String::from_utf8_lossy(b).into_owned()
 }
+
+/// Whether the process has installed its signal handler (the `ctrlc` crate runs it on a thread
+/// named `ctrl-c`). Without `/proc`, assume so after a while.
+#[cfg(unix)]
+pub fn handler_installed(pid: u32, since: std::time::Instant) -> bool {
+    let Ok(tasks) = std::fs::read_dir(format!("/proc/{pid}/task")) else {
+        return since.elapsed() > std::time::Duration::from_secs(3);
+    };
+    tasks
+        .filter_map(Result::ok)
+        .any(|t| std::fs::read_to_string(t.path().join("comm")).is_ok_and(|c| c.trim() == "ctrl-c"))
+}
