@@ -289,7 +289,7 @@ pub fn failure_reasons(c: &Comparison) -> Vec<String> {
                     z.failed_pixels, z.pixels
                 ));
             }
-            for s in z.scales.iter().filter(|s| !s.passed) {
+            for s in z.failed_scales() {
                 let mut line = format!(
                     "bias at {}: |z| {:.2} > {:.2}",
                     s.label(),

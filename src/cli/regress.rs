@@ -311,7 +311,7 @@ impl Tally {
         if !z.pixels_passed {
             self.pixel += 1;
         }
-        for s in z.scales.iter().filter(|s| !s.passed) {
+        for s in z.failed_scales() {
             match self.scales.iter_mut().find(|(l, _)| *l == s.label()) {
                 Some((_, n)) => *n += 1,
                 None => self.scales.push((s.label(), 1)),

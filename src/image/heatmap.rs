@@ -79,8 +79,7 @@ pub const OUTLINE: [u8; 3] = [255, 0, 255];
 fn failed_tiles(c: &Comparison) -> Vec<Region> {
     c.ztest
         .iter()
-        .flat_map(|z| &z.scales)
-        .filter(|s| !s.passed)
+        .flat_map(|z| z.failed_scales())
         .filter_map(|s| s.worst.map(|w| w.region))
         .filter(|r| matches!(r, Region::Rect { .. }))
         .collect()
@@ -180,12 +179,7 @@ mod tests {
         write_heatmap(&path, &c).unwrap();
         let png = ::image::open(&path).unwrap().to_rgb8();
         // The 8² tile's border is magenta; its inside and the rest keep their colours.
-        let failed: Vec<String> = z
-            .scales
-            .iter()
-            .filter(|s| !s.passed)
-            .map(|s| s.label())
-            .collect();
+        let failed: Vec<String> = z.failed_scales().map(|s| s.label()).collect();
         assert_eq!(failed, ["8x8"]);
         for (x, y) in [(8, 16), (15, 16), (8, 23), (15, 20)] {
             assert_eq!(png.get_pixel(x, y).0, OUTLINE, "({x}, {y})");

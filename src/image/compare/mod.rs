@@ -274,6 +274,13 @@ pub struct ZTest {
     pub passed: bool,
 }
 
+impl ZTest {
+    /// The aggregate scales that failed, largest first.
+    pub fn failed_scales(&self) -> impl Iterator<Item = &ScaleTest> {
+        self.scales.iter().filter(|s| !s.passed)
+    }
+}
+
 /// Each channel's mean over the pixels finite in both images, and their ratio.
 #[derive(Clone, Debug, PartialEq)]
 pub struct MeanRatio {
