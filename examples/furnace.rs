@@ -6,7 +6,7 @@
 
 use lapidary::bsdf::measure::{albedo_by_sampling, direction_deg};
 use lapidary::bsdf::{Base, Coat, ConductorIor, LayeredBsdf, Model, ReferenceParams, StackDesc};
-use lapidary::color::Spectrum;
+use lapidary::color::Rgb;
 
 /// One row: stack name, model name, `(θo, albedo)` pairs.
 type Row = (String, String, Vec<(f32, f32)>);
@@ -16,18 +16,13 @@ fn furnace(n: u64) -> Vec<Row> {
     let clear = |ior, roughness| Coat {
         ior,
         roughness,
-        absorption: Spectrum::ZERO,
+        absorption: Rgb::ZERO,
         thickness: 0.0,
     };
     let stacks = [
         (
             "white Lambert / clear coat η1.5 m5°",
-            StackDesc::new(
-                vec![clear(1.5, 5.0)],
-                Base::Lambert {
-                    albedo: Spectrum::ONE,
-                },
-            ),
+            StackDesc::new(vec![clear(1.5, 5.0)], Base::Lambert { albedo: Rgb::ONE }),
         ),
         (
             "perfect conductor m10° / clear coat η1.7 m7°",

@@ -13,11 +13,11 @@
 //!
 //! ```
 //! use lapidary::bsdf::{Base, Bxdf, Coat, LayeredBsdf, StackDesc};
-//! use lapidary::color::Spectrum;
+//! use lapidary::spectrum::RgbSample;
 //! use glam::Vec3;
 //!
-//! let coat = Coat { ior: 1.5, roughness: 5.0, absorption: Spectrum::ZERO, thickness: 0.0 };
-//! let stack = LayeredBsdf::new(&StackDesc::new(vec![coat], Base::Lambert { albedo: Spectrum::ONE }))?;
+//! let coat = Coat { ior: 1.5, roughness: 5.0, absorption: RgbSample::ZERO, thickness: 0.0 };
+//! let stack = LayeredBsdf::new(&StackDesc::new(vec![coat], Base::Lambert { albedo: RgbSample::ONE }))?;
 //! let wo = Vec3::new(0.3, 0.0, 0.954).normalize();
 //! let f = stack.eval(wo, Vec3::Z);
 //! assert!(f.is_valid() && f[0] > 0.0);
@@ -42,4 +42,5 @@ pub mod recipe;
 pub mod render;
 pub mod sampler;
 pub mod scene;
+pub mod spectrum;
 pub mod texture;

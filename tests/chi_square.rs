@@ -41,8 +41,8 @@ use common::{ChiSquare, SphereGrid, chi_square_pooled, chi2_p_value, par_map, si
 use glam::Vec3;
 use lapidary::bsdf::{Bxdf, Lambert, MicrofacetDistribution, TorranceSparrow};
 use lapidary::bsdf::{Distribution, Fresnel, measure::direction_deg};
-use lapidary::color::Spectrum;
 use lapidary::sampler::{Rng, hash_words};
+use lapidary::spectrum::RgbSample;
 use std::sync::Arc;
 use subjects::{SharedBxdf, Subject};
 use weights::{ABS_FLOOR, N_WEIGHT, REL_TOL, weight_check};
@@ -457,7 +457,7 @@ fn machinery_rejects_wrong_samplers() {
     let alpha = alpha_i();
     let wo = direction_deg(30.0, 40.0);
     let lambert: SharedBxdf = Arc::new(Lambert {
-        albedo: Spectrum::ONE,
+        albedo: RgbSample::ONE,
     });
     let glossy = |m: f32| -> SharedBxdf {
         Arc::new(TorranceSparrow::new(

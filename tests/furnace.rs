@@ -14,7 +14,7 @@
 
 use lapidary::bsdf::measure::{Estimate, albedo_by_sampling, direction_deg};
 use lapidary::bsdf::{Base, Coat, ConductorIor, LayeredBsdf, Model, ReferenceParams, StackDesc};
-use lapidary::color::Spectrum;
+use lapidary::color::Rgb;
 use lapidary::recipe::MaterialLibrary;
 use lapidary::sampler::hash_words;
 use rayon::prelude::*;
@@ -44,7 +44,7 @@ fn clear_coat(ior: f32, roughness: f32) -> Coat {
     Coat {
         ior,
         roughness,
-        absorption: Spectrum::ZERO,
+        absorption: Rgb::ZERO,
         thickness: 0.0,
     }
 }
@@ -53,9 +53,7 @@ fn clear_coat(ior: f32, roughness: f32) -> Coat {
 fn white_lambert_under_coat() -> StackDesc {
     StackDesc::new(
         vec![clear_coat(1.5, 5.0)],
-        Base::Lambert {
-            albedo: Spectrum::ONE,
-        },
+        Base::Lambert { albedo: Rgb::ONE },
     )
 }
 

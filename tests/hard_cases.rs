@@ -33,8 +33,9 @@ use lapidary::bsdf::{
     TorranceSparrow, TransportMode, fresnel, reflect, refract, refract_macro,
     sample_cosine_hemisphere, spherical_direction,
 };
-use lapidary::color::Spectrum;
+use lapidary::color::Rgb;
 use lapidary::recipe::MaterialLibrary;
+use lapidary::spectrum::RgbSample;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestCaseError, TestError, TestRng, TestRunner};
 use std::f32::consts::TAU;
@@ -101,13 +102,13 @@ fn close(a: f32, b: f32, rel: f32) -> bool {
     a == b || (a - b).abs() <= rel * a.abs().max(b.abs())
 }
 
-fn close_spectrum(a: Spectrum, b: Spectrum, rel: f32) -> bool {
+fn close_spectrum(a: RgbSample, b: RgbSample, rel: f32) -> bool {
     (0..3).all(|c| close(a[c], b[c], rel))
 }
 
 /// `weight == f·|cos θi|/pdf` per channel, to `REL` plus the absolute rounding of subnormal
 /// numbers (spacing 1.4e-45), which `f` or the weight may carry into the comparison.
-fn weight_matches(weight: Spectrum, f: Spectrum, cos: f32, pdf: f32) -> bool {
+fn weight_matches(weight: RgbSample, f: RgbSample, cos: f32, pdf: f32) -> bool {
     let subnormal_step = f32::from_bits(1);
     (0..3).all(|c| {
         let w = f[c] * (cos / pdf);
@@ -375,7 +376,7 @@ fn cavity_normals(d: &MicrofacetDistribution, u: Vec2) -> Vec<Vec3> {
 #[derive(Clone, Copy, Debug)]
 enum FresnelDesc {
     Dielectric(f32, FresnelMode),
-    Conductor(Spectrum, Spectrum, FresnelMode),
+    Conductor(RgbSample, RgbSample, FresnelMode),
     Perfect,
 }
 
@@ -391,8 +392,8 @@ impl FresnelDesc {
 
 #[derive(Clone, Copy, Debug)]
 enum Component {
-    Lambert(Spectrum),
-    OrenNayar(Spectrum, f32),
+    Lambert(RgbSample),
+    OrenNayar(RgbSample, f32),
     Torrance {
         distribution: Distribution,
         m: f32,
@@ -449,27 +450,27 @@ fn check_component(c: Component, bsdf: &Bsdf, q: &Query) -> Check {
 fn check_dielectric(d: &RoughDielectric, q: &Query) -> Check {
     let (wo, wi) = (q.wo, q.wi());
     for mode in [TransportMode::Radiance, TransportMode::Importance] {
-        let f = d.eval(wo, wi, mode);
+        let f = d.value(wo, wi, mode);
         ensure!(
             f.is_finite() && f >= 0.0,
             "eval(wo {wo:?}, wi {wi:?}, {mode:?}) = {f}"
         );
         for lobes in [Lobes::All, Lobes::Reflection, Lobes::Transmission] {
-            let p = d.pdf(wo, wi, lobes);
+            let p = d.pdf_lobes(wo, wi, lobes);
             ensure!(
                 p.is_finite() && p >= 0.0,
                 "pdf(wo {wo:?}, wi {wi:?}, {lobes:?}) = {p}"
             );
         }
         if f > 0.0 {
-            let p = d.pdf(wo, wi, Lobes::All);
+            let p = d.pdf_lobes(wo, wi, Lobes::All);
             ensure!(
                 p > 0.0,
                 "eval(wo {wo:?}, wi {wi:?}, {mode:?}) = {f} > 0 but pdf(All) = {p}"
             );
         }
         for lobes in [Lobes::All, Lobes::Reflection, Lobes::Transmission] {
-            let Some(s) = d.sample(wo, q.uc, q.u, mode, lobes) else {
+            let Some(s) = d.sample_lobes(wo, q.uc, q.u, mode, lobes) else {
                 continue;
             };
             let at = format!(
@@ -488,9 +489,9 @@ fn check_dielectric(d: &RoughDielectric, q: &Query) -> Check {
                 Lobes::Transmission => ensure!(side < 0.0, "{at}: transmission did not cross"),
                 Lobes::All => ensure!(side != 0.0, "{at}: wi in the surface plane"),
             }
-            let f = d.eval(wo, s.wi, mode);
+            let f = d.value(wo, s.wi, mode);
             ensure!(close(s.f[0], f, REL), "{at}: s.f != eval = {f}");
-            let p = d.pdf(wo, s.wi, lobes);
+            let p = d.pdf_lobes(wo, s.wi, lobes);
             ensure!(close(s.pdf, p, REL), "{at}: s.pdf != pdf = {p}");
             ensure!(
                 weight_matches(s.weight, s.f, s.wi.z.abs(), s.pdf),
@@ -506,8 +507,8 @@ fn check_dielectric(d: &RoughDielectric, q: &Query) -> Check {
         let mut dirs = vec![reflect(wo, h).normalize()];
         dirs.extend(refract(wo, h, d.eta));
         for c in dirs {
-            let f = d.eval(wo, c, TransportMode::Radiance);
-            let p = d.pdf(wo, c, Lobes::All);
+            let f = d.value(wo, c, TransportMode::Radiance);
+            let p = d.pdf_lobes(wo, c, Lobes::All);
             ensure!(
                 f.is_finite() && f >= 0.0 && p.is_finite() && p >= 0.0,
                 "sampled micro-normal {h:?}: eval(wo {wo:?}, {c:?}) = {f}, pdf = {p}"
@@ -521,7 +522,7 @@ fn check_dielectric(d: &RoughDielectric, q: &Query) -> Check {
     // The closed enum dispatches to the same thing.
     let via_enum = Bsdf::Dielectric(d.clone()).eval(wo, wi);
     ensure!(
-        via_enum == Spectrum::splat(d.eval(wo, wi, TransportMode::Radiance)),
+        via_enum == RgbSample::splat(d.value(wo, wi, TransportMode::Radiance)),
         "Bsdf::Dielectric disagrees"
     );
     Ok(())
@@ -633,7 +634,7 @@ fn coat(ior: f32, roughness: f32) -> Coat {
     Coat {
         ior,
         roughness,
-        absorption: Spectrum::ZERO,
+        absorption: Rgb::ZERO,
         thickness: 0.0,
     }
 }
@@ -642,22 +643,22 @@ fn absorbing(ior: f32, roughness: f32, od: f32) -> Coat {
     Coat {
         ior,
         roughness,
-        absorption: Spectrum::splat(od),
+        absorption: Rgb::splat(od),
         thickness: 1.0,
     }
 }
 
 fn lambert(a: f32) -> Base {
     Base::Lambert {
-        albedo: Spectrum::splat(a),
+        albedo: Rgb::splat(a),
     }
 }
 
 fn conductor(n: f32, k: f32, roughness: f32) -> Base {
     Base::Conductor {
         ior: ConductorIor::Complex {
-            n: Spectrum::splat(n),
-            k: Spectrum::splat(k),
+            n: Rgb::splat(n),
+            k: Rgb::splat(k),
         },
         roughness,
     }
@@ -674,7 +675,7 @@ fn perfect(roughness: f32) -> Base {
 /// are added by [`edge_stacks`]).
 fn edge_stack_shapes() -> Vec<(Vec<Coat>, Base)> {
     let on = |sigma| Base::OrenNayar {
-        albedo: Spectrum::rgb(1.0, 0.5, 0.0),
+        albedo: Rgb::new(1.0, 0.5, 0.0),
         sigma,
     };
     vec![
@@ -808,7 +809,7 @@ fn check_fresnel(cos: f32, eta: f32, n: f32, k: f32) -> Check {
 }
 
 fn check_fresnel_objects(cos: f32, eta: f32, n: f32, k: f32) -> Check {
-    let nk = (Spectrum::rgb(n, 1.0, 0.2), Spectrum::rgb(k, 0.0, 10.0));
+    let nk = (RgbSample::rgb(n, 1.0, 0.2), RgbSample::rgb(k, 0.0, 10.0));
     for mode in FRESNEL_MODES {
         for (what, fr) in [
             ("dielectric", Fresnel::dielectric(eta, mode)),
@@ -999,11 +1000,11 @@ fn check_microfacet(d: &MicrofacetDistribution, u: Vec2) -> Check {
 /// Components at the edges of their parameters.
 fn edge_components() -> Vec<Component> {
     let mut out = vec![
-        Component::Lambert(Spectrum::ONE),
-        Component::Lambert(Spectrum::ZERO),
-        Component::OrenNayar(Spectrum::ONE, 0.0),
-        Component::OrenNayar(Spectrum::ONE, 1.0),
-        Component::OrenNayar(Spectrum::rgb(1.0, 0.3, 0.0), 0.5),
+        Component::Lambert(RgbSample::ONE),
+        Component::Lambert(RgbSample::ZERO),
+        Component::OrenNayar(RgbSample::ONE, 0.0),
+        Component::OrenNayar(RgbSample::ONE, 1.0),
+        Component::OrenNayar(RgbSample::rgb(1.0, 0.3, 0.0), 0.5),
     ];
     let fresnels = [
         FresnelDesc::Perfect,
@@ -1012,28 +1013,28 @@ fn edge_components() -> Vec<Component> {
         FresnelDesc::Dielectric(0.25, FresnelMode::Table),
         FresnelDesc::Dielectric(1.5, FresnelMode::Lazanyi),
         FresnelDesc::Conductor(
-            Spectrum::splat(0.01),
-            Spectrum::splat(10.0),
+            RgbSample::splat(0.01),
+            RgbSample::splat(10.0),
             FresnelMode::Exact,
         ),
         FresnelDesc::Conductor(
-            Spectrum::splat(4.0),
-            Spectrum::splat(0.0),
+            RgbSample::splat(4.0),
+            RgbSample::splat(0.0),
             FresnelMode::Table,
         ),
         FresnelDesc::Conductor(
-            Spectrum::splat(1.0),
-            Spectrum::splat(0.0),
+            RgbSample::splat(1.0),
+            RgbSample::splat(0.0),
             FresnelMode::Table,
         ),
         FresnelDesc::Conductor(
-            Spectrum::rgb(0.2, 1.0, 4.0),
-            Spectrum::rgb(3.0, 0.0, 10.0),
+            RgbSample::rgb(0.2, 1.0, 4.0),
+            RgbSample::rgb(3.0, 0.0, 10.0),
             FresnelMode::Schlick,
         ),
         FresnelDesc::Conductor(
-            Spectrum::rgb(0.2, 1.0, 4.0),
-            Spectrum::rgb(3.0, 0.0, 10.0),
+            RgbSample::rgb(0.2, 1.0, 4.0),
+            RgbSample::rgb(3.0, 0.0, 10.0),
             FresnelMode::Lazanyi,
         ),
     ];
@@ -1196,9 +1197,9 @@ fn check_opaque_varnish(desc: &StackDesc) -> Check {
             match stack.model() {
                 Model::Reference(_) => {
                     let expect = if wo.z > 0.0 && wi.z > 0.0 {
-                        Spectrum::splat(iface.eval(wo, wi, TransportMode::Radiance))
+                        RgbSample::splat(iface.value(wo, wi, TransportMode::Radiance))
                     } else {
-                        Spectrum::ZERO
+                        RgbSample::ZERO
                     };
                     ensure!(
                         close_spectrum(f, expect, REL),
@@ -1238,7 +1239,7 @@ fn huge_optical_depth_underflows_to_the_top_lobe() {
             k += 1;
             // The same optical depth as an absorption of 1 through 1e3 units, over another coat.
             let mut d2 = d.clone();
-            d2.coats[0].absorption = Spectrum::ONE;
+            d2.coats[0].absorption = Rgb::ONE;
             d2.coats[0].thickness = 1e3;
             d2.coats.push(coat(2.0, 3.0));
             d2.fresnel = FRESNEL_MODES[(k + 1) % 4];
@@ -1314,18 +1315,18 @@ fn corruptions() -> Vec<(&'static str, StackDesc)> {
     for v in [-1e-30f32, -1.0].into_iter().chain(bad_f) {
         push("thickness", &|d| d.coats[0].thickness = v);
         push("absorption", &|d| {
-            d.coats[1].absorption = Spectrum::rgb(0.1, v, 0.1)
+            d.coats[1].absorption = Rgb::new(0.1, v, 0.1)
         });
     }
     for v in [-0.1f32, 1.1].into_iter().chain(bad_f) {
         push("lambert albedo", &|d| {
             d.base = Base::Lambert {
-                albedo: Spectrum::rgb(0.5, 0.5, v),
+                albedo: Rgb::new(0.5, 0.5, v),
             }
         });
         push("oren-nayar albedo", &|d| {
             d.base = Base::OrenNayar {
-                albedo: Spectrum::rgb(v, 0.5, 0.5),
+                albedo: Rgb::new(v, 0.5, 0.5),
                 sigma: 0.3,
             }
         });
@@ -1333,7 +1334,7 @@ fn corruptions() -> Vec<(&'static str, StackDesc)> {
     for v in [-0.1f32, 3.0].into_iter().chain(bad_f) {
         push("oren-nayar sigma", &|d| {
             d.base = Base::OrenNayar {
-                albedo: Spectrum::ONE,
+                albedo: Rgb::ONE,
                 sigma: v,
             }
         });
@@ -1342,8 +1343,8 @@ fn corruptions() -> Vec<(&'static str, StackDesc)> {
         push("conductor n", &|d| {
             d.base = Base::Conductor {
                 ior: ConductorIor::Complex {
-                    n: Spectrum::rgb(0.2, v, 0.2),
-                    k: Spectrum::splat(3.0),
+                    n: Rgb::new(0.2, v, 0.2),
+                    k: Rgb::splat(3.0),
                 },
                 roughness: 10.0,
             }
@@ -1353,8 +1354,8 @@ fn corruptions() -> Vec<(&'static str, StackDesc)> {
         push("conductor k", &|d| {
             d.base = Base::Conductor {
                 ior: ConductorIor::Complex {
-                    n: Spectrum::splat(0.2),
-                    k: Spectrum::rgb(3.0, 3.0, v),
+                    n: Rgb::splat(0.2),
+                    k: Rgb::new(3.0, 3.0, v),
                 },
                 roughness: 10.0,
             }
@@ -1399,7 +1400,7 @@ fn construction_accepts_range_edges() {
         (
             vec![coat(10.0, 0.01), coat(1.0001, 89.99)],
             Base::OrenNayar {
-                albedo: Spectrum::ONE,
+                albedo: Rgb::ONE,
                 sigma: 1.5,
             },
         ),
@@ -1450,8 +1451,8 @@ fn unit_interval() -> impl Strategy<Value = f32> {
 }
 
 /// Three independent channels, each drawn from `channel()`.
-fn spectrum<S: Strategy<Value = f32>>(channel: impl Fn() -> S) -> impl Strategy<Value = Spectrum> {
-    (channel(), channel(), channel()).prop_map(|(r, g, b)| Spectrum::rgb(r, g, b))
+fn spectrum<S: Strategy<Value = f32>>(channel: impl Fn() -> S) -> impl Strategy<Value = Rgb> {
+    (channel(), channel(), channel()).prop_map(|(r, g, b)| Rgb::new(r, g, b))
 }
 
 fn conductor_n() -> impl Strategy<Value = f32> {
@@ -1547,16 +1548,16 @@ fn fresnel_desc() -> impl Strategy<Value = FresnelDesc> {
         )
             .prop_map(|(e, m)| FresnelDesc::Dielectric(e, m)),
         3 => (spectrum(conductor_n), spectrum(conductor_k), fresnel_mode())
-            .prop_map(|(n, k, m)| FresnelDesc::Conductor(n, k, m)),
+            .prop_map(|(n, k, m)| FresnelDesc::Conductor(n.into(), k.into(), m)),
         1 => Just(FresnelDesc::Perfect),
     ]
 }
 
 fn component() -> impl Strategy<Value = Component> {
     prop_oneof![
-        1 => spectrum(unit_interval).prop_map(Component::Lambert),
+        1 => spectrum(unit_interval).prop_map(|a| Component::Lambert(a.into())),
         2 => (spectrum(unit_interval), unit_interval())
-            .prop_map(|(a, s)| Component::OrenNayar(a, s)),
+            .prop_map(|(a, s)| Component::OrenNayar(a.into(), s)),
         // Compensation builds a table (milliseconds): one Torrance–Sparrow lobe in eight.
         5 => (distribution(), roughness(), fresnel_desc(), 0u8..8).prop_map(
             |(distribution, m, fresnel, c)| Component::Torrance {
@@ -1874,7 +1875,7 @@ fn rejection_property(cases: u32) {
                 3 => {
                     let mut a = desc.coats[c].absorption.0;
                     a[ch] = bad;
-                    desc.coats[c].absorption = Spectrum(a);
+                    desc.coats[c].absorption = Rgb(a);
                 }
                 4 => {
                     desc.base = Base::Conductor {
@@ -1885,17 +1886,15 @@ fn rejection_property(cases: u32) {
                 5 => {
                     let mut a = [0.5; 3];
                     a[ch] = bad;
-                    desc.base = Base::Lambert {
-                        albedo: Spectrum(a),
-                    }
+                    desc.base = Base::Lambert { albedo: Rgb(a) }
                 }
                 _ => {
                     let mut k = [1.0; 3];
                     k[ch] = bad;
                     desc.base = Base::Conductor {
                         ior: ConductorIor::Complex {
-                            n: Spectrum::ONE,
-                            k: Spectrum(k),
+                            n: Rgb::ONE,
+                            k: Rgb(k),
                         },
                         roughness: 10.0,
                     }

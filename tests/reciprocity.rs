@@ -17,14 +17,14 @@
 //! Run with the table printed: `cargo test --release --test reciprocity -- --nocapture`.
 
 use glam::Vec3;
-use lapidary::bsdf::dielectric::TransportMode;
+use lapidary::bsdf::TransportMode;
 use lapidary::bsdf::measure::direction_deg;
 use lapidary::bsdf::{
     Bxdf, Distribution, Fresnel, FresnelMode, Lambert, LayeredBsdf, Metal, MicrofacetDistribution,
     Model, OrenNayar, ReferenceParams, RoughDielectric, TorranceSparrow,
 };
-use lapidary::color::Spectrum;
 use lapidary::recipe::MaterialLibrary;
+use lapidary::spectrum::RgbSample;
 use rayon::prelude::*;
 
 /// Relative tolerance of the reflection components (f32 rounding of half vectors and Fresnel
@@ -62,9 +62,9 @@ const TAIL: f32 = 1e-7;
 fn check_pairs(
     name: &str,
     tol: f32,
-    g: &dyn Fn(Vec3, Vec3) -> (Spectrum, Spectrum),
+    g: &dyn Fn(Vec3, Vec3) -> (RgbSample, RgbSample),
 ) -> (f32, usize) {
-    let values: Vec<(Vec3, Vec3, Spectrum, Spectrum)> = component_pairs()
+    let values: Vec<(Vec3, Vec3, RgbSample, RgbSample)> = component_pairs()
         .into_iter()
         .map(|(wo, wi)| {
             let (a, b) = g(wo, wi);
@@ -101,7 +101,7 @@ fn check_pairs(
 #[test]
 fn components_are_reciprocal() {
     let mut report = Vec::new();
-    let mut run = |name: String, g: &dyn Fn(Vec3, Vec3) -> (Spectrum, Spectrum)| {
+    let mut run = |name: String, g: &dyn Fn(Vec3, Vec3) -> (RgbSample, RgbSample)| {
         let tol = if name.contains("trans.") {
             TRANSMISSION_TOL
         } else {
@@ -114,16 +114,16 @@ fn components_are_reciprocal() {
             "{name:<52} worst rel. difference {worst:.1e}, {nonzero} pairs > 0"
         ));
     };
-    let sym = |f: &dyn Fn(Vec3, Vec3) -> Spectrum, a: Vec3, b: Vec3| (f(a, b), f(b, a));
+    let sym = |f: &dyn Fn(Vec3, Vec3) -> RgbSample, a: Vec3, b: Vec3| (f(a, b), f(b, a));
     let lambert = Lambert {
-        albedo: Spectrum::rgb(0.2, 0.5, 0.9),
+        albedo: RgbSample::rgb(0.2, 0.5, 0.9),
     };
     run("Lambert".into(), &|a, b| {
         sym(&|x, y| lambert.eval(x, y), a, b)
     });
     for sigma in [0.0, 0.26, 0.5, 1.0] {
         let on = OrenNayar {
-            albedo: Spectrum::rgb(0.8, 0.5, 0.3),
+            albedo: RgbSample::rgb(0.8, 0.5, 0.3),
             sigma,
         };
         run(format!("Oren–Nayar σ={sigma}"), &|a, b| {
@@ -141,14 +141,17 @@ fn components_are_reciprocal() {
             });
             for metal in [Metal::Gold, Metal::Aluminium] {
                 let (n, k) = metal.nk();
-                let cond = TorranceSparrow::new(d, Fresnel::conductor(n, k, FresnelMode::Exact));
+                let cond = TorranceSparrow::new(
+                    d,
+                    Fresnel::conductor(n.into(), k.into(), FresnelMode::Exact),
+                );
                 run(
                     format!("TS conductor {} {dist:?} m={m}°", metal.name()),
                     &|a, b| sym(&|x, y| cond.eval(x, y), a, b),
                 );
             }
             let glass = RoughDielectric::new(d, eta);
-            let f = |x: Vec3, y: Vec3, mode| Spectrum::splat(glass.eval(x, y, mode));
+            let f = |x: Vec3, y: Vec3, mode| RgbSample::splat(glass.value(x, y, mode));
             run(
                 format!("RoughDielectric refl. above {dist:?} m={m}°"),
                 &|a, b| sym(&|x, y| f(x, y, rad), a, b),

@@ -18,9 +18,10 @@ use lapidary::bsdf::{
     Base, Bxdf, Coat, Distribution, Fresnel, FresnelMode, LayeredBsdf, MicrofacetDistribution,
     Model, ReferenceParams, StackDesc, TorranceSparrow,
 };
-use lapidary::color::Spectrum;
+use lapidary::color::Rgb;
 use lapidary::recipe::MaterialLibrary;
 use lapidary::sampler::hash_words;
+use lapidary::spectrum::RgbSample;
 use rayon::prelude::*;
 
 const SAMPLING_N: u64 = 200_000;
@@ -100,7 +101,7 @@ fn sample_weight_matches_integrated_eval() {
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
-fn bits(s: Spectrum) -> [u32; 3] {
+fn bits(s: RgbSample) -> [u32; 3] {
     s.0.map(f32::to_bits)
 }
 
@@ -206,7 +207,7 @@ fn huge_absorption_leaves_only_the_top_reflection() {
     let coat = Coat {
         ior: 1.5,
         roughness: m,
-        absorption: Spectrum::splat(1e3),
+        absorption: Rgb::splat(1e3),
         thickness: 1.0,
     };
     let top = TorranceSparrow::new(
@@ -214,11 +215,9 @@ fn huge_absorption_leaves_only_the_top_reflection() {
         Fresnel::dielectric(1.5, FresnelMode::Exact),
     );
     let bases = [
-        Base::Lambert {
-            albedo: Spectrum::ONE,
-        },
+        Base::Lambert { albedo: Rgb::ONE },
         Base::OrenNayar {
-            albedo: Spectrum::splat(0.8),
+            albedo: Rgb::splat(0.8),
             sigma: 0.3,
         },
     ];

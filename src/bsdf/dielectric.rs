@@ -12,22 +12,13 @@
 
 use super::table::Table;
 use super::{
-    BsdfSample, Lobe, LobeKind, MicrofacetDistribution, fresnel, microfacet::v_cavity_g, reflect,
-    refract,
+    BsdfSample, Bxdf, Lobe, LobeFlags, LobeKind, MicrofacetDistribution, TransportMode, fresnel,
+    microfacet::v_cavity_g, reflect, refract,
 };
-use crate::color::Spectrum;
 use crate::sampler::hash_words;
+use crate::spectrum::RgbSample;
 use glam::{Vec2, Vec3};
 use std::sync::Arc;
-
-/// Whether a BSDF transports radiance (paths from the camera) or importance (from the light).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum TransportMode {
-    /// Radiance: `wo` is toward the camera.
-    Radiance,
-    /// Importance: the adjoint.
-    Importance,
-}
 
 /// Which lobes a call may sample.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -82,8 +73,8 @@ impl RoughDielectric {
                 |wo, uc, u| {
                     let wo = Vec3::new(wo.x, wo.y, sign * wo.z);
                     plain
-                        .sample(wo, uc, u, TransportMode::Importance, Lobes::All)
-                        .map_or(Spectrum::ZERO, |s| s.weight)
+                        .sample_lobes(wo, uc, u, TransportMode::Importance, Lobes::All)
+                        .map_or(RgbSample::ZERO, |s| s.weight)
                 },
             )
         };
@@ -139,7 +130,7 @@ impl RoughDielectric {
     }
 
     /// `f(wo, wi)` in sr⁻¹ (cosine excluded) for directions on either side.
-    pub fn eval(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> f32 {
+    pub fn value(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> f32 {
         let Some((h, is_reflect, etap)) = self.half(wo, wi) else {
             return 0.0;
         };
@@ -167,7 +158,7 @@ impl RoughDielectric {
     }
 
     /// Density of sampling `wi` from `wo` with the given lobes allowed.
-    pub fn pdf(&self, wo: Vec3, wi: Vec3, lobes: Lobes) -> f32 {
+    pub fn pdf_lobes(&self, wo: Vec3, wi: Vec3, lobes: Lobes) -> f32 {
         let Some((h, is_reflect, etap)) = self.half(wo, wi) else {
             return 0.0;
         };
@@ -195,7 +186,7 @@ impl RoughDielectric {
     /// # Arguments
     /// * `uc` – picks reflection vs transmission.
     /// * `u` – picks the micro-normal.
-    pub fn sample(
+    pub fn sample_lobes(
         &self,
         wo: Vec3,
         uc: f32,
@@ -233,14 +224,37 @@ impl RoughDielectric {
             }
             wi
         };
-        let f = self.eval(wo, wi, mode);
-        let pdf = self.pdf(wo, wi, lobes);
-        let kind = if wi.z * wo.z > 0.0 {
-            LobeKind::Glossy
+        let f = self.value(wo, wi, mode);
+        let pdf = self.pdf_lobes(wo, wi, lobes);
+        let (kind, eta) = if wi.z * wo.z > 0.0 {
+            (LobeKind::Glossy, 1.0)
+        } else if wo.z > 0.0 {
+            (LobeKind::Transmission, self.eta)
         } else {
-            LobeKind::Transmission
+            (LobeKind::Transmission, 1.0 / self.eta)
         };
-        BsdfSample::from_eval(wi, Spectrum::splat(f), pdf, Lobe { kind, layer: 0 })
+        BsdfSample::from_eval(wi, RgbSample::splat(f), pdf, Lobe { kind, layer: 0 })
+            .map(|s| s.with_eta(eta))
+    }
+}
+
+/// The interface as a full BSDF: both lobes, chosen by Fresnel, directions on either side.
+impl Bxdf for RoughDielectric {
+    #[inline]
+    fn flags(&self) -> LobeFlags {
+        LobeFlags::REFLECTION | LobeFlags::TRANSMISSION | LobeFlags::GLOSSY
+    }
+    #[inline]
+    fn eval_mode(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> RgbSample {
+        RgbSample::splat(self.value(wo, wi, mode))
+    }
+    #[inline]
+    fn sample_mode(&self, wo: Vec3, uc: f32, u: Vec2, mode: TransportMode) -> Option<BsdfSample> {
+        self.sample_lobes(wo, uc, u, mode, Lobes::All)
+    }
+    #[inline]
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        self.pdf_lobes(wo, wi, Lobes::All)
     }
 }
 
@@ -258,12 +272,12 @@ mod tests {
         let g = glass(15.0);
         let wo = spherical_direction(0.4, 0.0);
         let wi = -spherical_direction(0.3, 2.9);
-        let a = g.eval(wo, wi, TransportMode::Radiance);
-        let b = g.eval(wi, wo, TransportMode::Importance);
+        let a = g.value(wo, wi, TransportMode::Radiance);
+        let b = g.value(wi, wo, TransportMode::Importance);
         assert!(a > 0.0 && (a - b).abs() < 1e-4 * a, "{a} {b}");
         // Generalised reciprocity (Veach 1997, eq. 5.14): f(wo,wi)/η_o² = f(wi,wo)/η_i² in radiance
         // mode; here wo is outside (η 1) and wi inside (η 1.5).
-        let c = g.eval(wi, wo, TransportMode::Radiance);
+        let c = g.value(wi, wo, TransportMode::Radiance);
         assert!((a * 1.5f32.powi(2) - c).abs() < 1e-4 * c, "{a} {c}");
     }
 
@@ -278,7 +292,7 @@ mod tests {
             let n = 200_000;
             let mut sum = 0.0f64;
             for _ in 0..n {
-                if let Some(s) = g.sample(
+                if let Some(s) = g.sample_lobes(
                     wo,
                     rng.uniform(),
                     rng.uniform2(),

@@ -7,7 +7,8 @@
 //! IOR 1 relative), negative when it arrives from inside (relative IOR inverted; total internal
 //! reflection returns 1). Conductors ignore the sign.
 
-use crate::color::Spectrum;
+use crate::color::Rgb;
+use crate::spectrum::RgbSample;
 use serde::{Deserialize, Serialize};
 use std::sync::Arc;
 
@@ -120,8 +121,8 @@ pub const TABLE_SIZE: usize = 1024;
 /// keep one row for light from outside and one from inside (total internal reflection).
 #[derive(Debug, PartialEq)]
 pub struct FresnelTable {
-    outside: Vec<Spectrum>,
-    inside: Vec<Spectrum>,
+    outside: Vec<RgbSample>,
+    inside: Vec<RgbSample>,
 }
 
 impl FresnelTable {
@@ -138,7 +139,7 @@ impl FresnelTable {
     }
 
     #[inline]
-    fn lookup(&self, cos_i: f32) -> Spectrum {
+    fn lookup(&self, cos_i: f32) -> RgbSample {
         let row = if cos_i >= 0.0 {
             &self.outside
         } else {
@@ -162,9 +163,9 @@ pub enum Fresnel {
     /// Exact conductor, complex relative IOR per channel.
     Conductor {
         /// Real part per channel.
-        n: Spectrum,
+        n: RgbSample,
         /// Imaginary part (extinction) per channel.
-        k: Spectrum,
+        k: RgbSample,
     },
     /// A perfect mirror: reflectance 1 at every angle.
     Perfect,
@@ -176,14 +177,14 @@ pub enum Fresnel {
     /// Schlick's approximation for a conductor, `R0` from `n, k`.
     SchlickConductor {
         /// Normal-incidence reflectance per channel.
-        r0: Spectrum,
+        r0: RgbSample,
     },
     /// Lazányi–Szirmay-Kalos.
     Lazanyi {
         /// Real part per channel.
-        n: Spectrum,
+        n: RgbSample,
         /// Imaginary part per channel.
-        k: Spectrum,
+        k: RgbSample,
     },
     /// A precomputed table of one of the exact forms.
     Table(Arc<FresnelTable>),
@@ -197,15 +198,15 @@ impl Fresnel {
             FresnelMode::Exact => exact,
             FresnelMode::Schlick => Fresnel::SchlickDielectric { eta },
             FresnelMode::Lazanyi => Fresnel::Lazanyi {
-                n: Spectrum::splat(eta),
-                k: Spectrum::ZERO,
+                n: RgbSample::splat(eta),
+                k: RgbSample::ZERO,
             },
             FresnelMode::Table => Fresnel::Table(Arc::new(FresnelTable::build(&exact))),
         }
     }
 
     /// A conductor with complex relative IOR `n + i k`, evaluated in `mode`.
-    pub fn conductor(n: Spectrum, k: Spectrum, mode: FresnelMode) -> Self {
+    pub fn conductor(n: RgbSample, k: RgbSample, mode: FresnelMode) -> Self {
         let exact = Fresnel::Conductor { n, k };
         match mode {
             FresnelMode::Exact => exact,
@@ -221,26 +222,26 @@ impl Fresnel {
 
     /// Reflectance for the signed cosine `cos_i` (see the module docs).
     #[inline]
-    pub fn eval(&self, cos_i: f32) -> Spectrum {
+    pub fn eval(&self, cos_i: f32) -> RgbSample {
         match self {
-            Fresnel::Dielectric { eta } => Spectrum::splat(dielectric(cos_i, *eta)),
-            Fresnel::Conductor { n, k } => Spectrum([
+            Fresnel::Dielectric { eta } => RgbSample::splat(dielectric(cos_i, *eta)),
+            Fresnel::Conductor { n, k } => RgbSample([
                 conductor(cos_i, n[0], k[0]),
                 conductor(cos_i, n[1], k[1]),
                 conductor(cos_i, n[2], k[2]),
             ]),
-            Fresnel::Perfect => Spectrum::ONE,
-            Fresnel::SchlickDielectric { eta } => Spectrum::splat(schlick_dielectric(cos_i, *eta)),
+            Fresnel::Perfect => RgbSample::ONE,
+            Fresnel::SchlickDielectric { eta } => RgbSample::splat(schlick_dielectric(cos_i, *eta)),
             Fresnel::SchlickConductor { r0 } => {
                 let w = (1.0 - cos_i.abs().min(1.0)).powi(5);
-                *r0 + (Spectrum::ONE - *r0) * w
+                *r0 + (RgbSample::ONE - *r0) * w
             }
             Fresnel::Lazanyi { n, k } => {
                 if cos_i < 0.0 && k.is_black() {
                     // A dielectric seen from inside: same formula at the outside angle, or TIR.
-                    Spectrum::splat(schlick_like_inside(cos_i, n[0]))
+                    RgbSample::splat(schlick_like_inside(cos_i, n[0]))
                 } else {
-                    Spectrum([
+                    RgbSample([
                         lazanyi(cos_i, n[0], k[0]),
                         lazanyi(cos_i, n[1], k[1]),
                         lazanyi(cos_i, n[2], k[2]),
@@ -294,28 +295,13 @@ impl Metal {
     ];
 
     /// `(n, k)` per channel, relative to vacuum.
-    pub fn nk(self) -> (Spectrum, Spectrum) {
+    pub fn nk(self) -> (Rgb, Rgb) {
         match self {
-            Metal::Gold => (
-                Spectrum::rgb(0.21, 0.43, 1.31),
-                Spectrum::rgb(3.272, 2.455, 1.849),
-            ),
-            Metal::Silver => (
-                Spectrum::rgb(0.06, 0.06, 0.05),
-                Spectrum::rgb(4.152, 3.586, 2.869),
-            ),
-            Metal::Copper => (
-                Spectrum::rgb(0.27, 1.00, 1.22),
-                Spectrum::rgb(3.41, 2.58, 2.42),
-            ),
-            Metal::Aluminium => (
-                Spectrum::rgb(1.27, 0.96, 0.66),
-                Spectrum::rgb(7.30, 6.69, 5.60),
-            ),
-            Metal::Brass => (
-                Spectrum::rgb(0.444, 0.527, 1.094),
-                Spectrum::rgb(3.695, 2.765, 1.829),
-            ),
+            Metal::Gold => (Rgb::new(0.21, 0.43, 1.31), Rgb::new(3.272, 2.455, 1.849)),
+            Metal::Silver => (Rgb::new(0.06, 0.06, 0.05), Rgb::new(4.152, 3.586, 2.869)),
+            Metal::Copper => (Rgb::new(0.27, 1.00, 1.22), Rgb::new(3.41, 2.58, 2.42)),
+            Metal::Aluminium => (Rgb::new(1.27, 0.96, 0.66), Rgb::new(7.30, 6.69, 5.60)),
+            Metal::Brass => (Rgb::new(0.444, 0.527, 1.094), Rgb::new(3.695, 2.765, 1.829)),
         }
     }
 
@@ -394,21 +380,25 @@ mod tests {
     fn presets_reflect_like_metals() {
         for m in Metal::ALL {
             let (n, k) = m.nk();
-            let f = Fresnel::conductor(n, k, FresnelMode::Exact).eval(1.0);
+            let f = Fresnel::conductor(n.into(), k.into(), FresnelMode::Exact).eval(1.0);
             assert!(
                 f.min_channel() > 0.35 && f.max_channel() < 1.0,
                 "{m:?} {f:?}"
             );
         }
-        let gold = Fresnel::conductor(Metal::Gold.nk().0, Metal::Gold.nk().1, FresnelMode::Exact)
-            .eval(1.0);
+        let gold = Fresnel::conductor(
+            Metal::Gold.nk().0.into(),
+            Metal::Gold.nk().1.into(),
+            FresnelMode::Exact,
+        )
+        .eval(1.0);
         assert!(
             gold[0] > gold[1] && gold[1] > gold[2],
             "gold is yellow: {gold:?}"
         );
         let silver = Fresnel::conductor(
-            Metal::Silver.nk().0,
-            Metal::Silver.nk().1,
+            Metal::Silver.nk().0.into(),
+            Metal::Silver.nk().1.into(),
             FresnelMode::Exact,
         )
         .eval(1.0);
@@ -418,13 +408,13 @@ mod tests {
     #[test]
     fn approximations_track_exact() {
         let (n, k) = Metal::Gold.nk();
-        let exact = Fresnel::conductor(n, k, FresnelMode::Exact);
+        let exact = Fresnel::conductor(n.into(), k.into(), FresnelMode::Exact);
         for mode in [
             FresnelMode::Schlick,
             FresnelMode::Lazanyi,
             FresnelMode::Table,
         ] {
-            let approx = Fresnel::conductor(n, k, mode);
+            let approx = Fresnel::conductor(n.into(), k.into(), mode);
             let mut worst = 0.0f32;
             for i in 0..=1000 {
                 let c = i as f32 / 1000.0;

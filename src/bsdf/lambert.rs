@@ -1,7 +1,9 @@
 //! Lambertian reflection `f = ρ/π` with cosine-weighted sampling.
 
-use super::{Bsdf, BsdfSample, Bxdf, Lobe, LobeKind, sample_cosine_hemisphere};
-use crate::color::Spectrum;
+use super::{
+    Bsdf, BsdfSample, Bxdf, Lobe, LobeFlags, LobeKind, TransportMode, sample_cosine_hemisphere,
+};
+use crate::spectrum::RgbSample;
 use glam::{Vec2, Vec3};
 use std::f32::consts::FRAC_1_PI;
 
@@ -9,19 +11,23 @@ use std::f32::consts::FRAC_1_PI;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Lambert {
     /// Hemispherical albedo per channel.
-    pub albedo: Spectrum,
+    pub albedo: RgbSample,
 }
 
 impl Bxdf for Lambert {
     #[inline]
-    fn eval(&self, wo: Vec3, wi: Vec3) -> Spectrum {
+    fn flags(&self) -> LobeFlags {
+        LobeFlags::REFLECTION | LobeFlags::DIFFUSE
+    }
+    #[inline]
+    fn eval_mode(&self, wo: Vec3, wi: Vec3, _mode: TransportMode) -> RgbSample {
         if wo.z <= 0.0 || wi.z <= 0.0 {
-            return Spectrum::ZERO;
+            return RgbSample::ZERO;
         }
         self.albedo * FRAC_1_PI
     }
     #[inline]
-    fn sample(&self, wo: Vec3, _uc: f32, u: Vec2) -> Option<BsdfSample> {
+    fn sample_mode(&self, wo: Vec3, _uc: f32, u: Vec2, _mode: TransportMode) -> Option<BsdfSample> {
         if wo.z <= 0.0 {
             return None;
         }
@@ -59,7 +65,7 @@ mod tests {
     #[test]
     fn weight_is_albedo() {
         let l = Lambert {
-            albedo: Spectrum::rgb(0.2, 0.5, 0.9),
+            albedo: RgbSample::rgb(0.2, 0.5, 0.9),
         };
         let s = l.sample(Vec3::Z, 0.0, Vec2::new(0.1, 0.7)).unwrap();
         assert!((s.weight - l.albedo).map(f32::abs).max_channel() < 1e-6);

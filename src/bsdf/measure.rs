@@ -2,17 +2,17 @@
 //! sampling, and by integrating `eval` (independent of the sampler).
 
 use super::{Bxdf, spherical_direction};
-use crate::color::Spectrum;
 use crate::sampler::{Rng, hash_words};
+use crate::spectrum::RgbSample;
 use glam::{Vec2, Vec3};
 
 /// A Monte Carlo estimate per channel with its standard error.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Estimate {
     /// Sample mean per channel.
-    pub mean: Spectrum,
+    pub mean: RgbSample,
     /// Standard error of the mean per channel.
-    pub std_error: Spectrum,
+    pub std_error: RgbSample,
     /// Number of samples.
     pub samples: u64,
 }
@@ -28,8 +28,8 @@ fn finish(sum: [f64; 3], sum2: [f64; 3], n: u64) -> Estimate {
         se[c] = (var / nf).sqrt() as f32;
     }
     Estimate {
-        mean: Spectrum(mean),
-        std_error: Spectrum(se),
+        mean: RgbSample(mean),
+        std_error: RgbSample(se),
         samples: n,
     }
 }
@@ -116,7 +116,7 @@ mod tests {
     #[test]
     fn lambert_albedo_both_ways() {
         let l = Lambert {
-            albedo: Spectrum::rgb(0.25, 0.5, 1.0),
+            albedo: RgbSample::rgb(0.25, 0.5, 1.0),
         };
         let wo = direction_deg(40.0, 0.0);
         let a = albedo_by_sampling(&l, wo, 10_000, 1);

@@ -17,7 +17,8 @@
 //!   `α = tan m`, normalised Blinn exponent `e = 2/α² − 2` (Walter et al. 2007, eq. 31), and
 //!   `D(h) = (e+2)/(2π) · cos^e θh` (course eq. 3.7).
 //! - Oren–Nayar `σ` is in radians. IORs are absolute in descriptions and relative (below / above) at
-//!   an interface. Colours are linear Rec.709 [`Spectrum`]s.
+//!   an interface. Stored colours are [`crate::color::Rgb`]; values are transported light
+//!   ([`crate::spectrum::Spectral`], [`RgbSample`] in the RGB variant).
 //! - Every result is finite and non-negative for every input the types allow, including grazing
 //!   `cos θ` down to 1e-7, `wo == wi`, `wo == -wi` and `u` exactly 0 or 1 (docs/design.md §5.3); whenever
 //!   `f > 0` for a direction that `sample` can produce, its `pdf > 0`.
@@ -29,10 +30,12 @@ pub mod layered;
 pub mod measure;
 pub mod microfacet;
 pub mod oren_nayar;
+pub mod record;
+pub mod smooth_dielectric;
 pub mod table;
 pub mod torrance_sparrow;
 
-pub use dielectric::{RoughDielectric, TransportMode};
+pub use dielectric::RoughDielectric;
 pub use fresnel::{Fresnel, FresnelMode, Metal};
 pub use lambert::Lambert;
 pub use layered::{
@@ -40,86 +43,49 @@ pub use layered::{
 };
 pub use microfacet::{Distribution, MicrofacetDistribution};
 pub use oren_nayar::OrenNayar;
+pub use record::{BsdfSample, Lobe, LobeFlags, LobeKind, TransportMode};
+pub use smooth_dielectric::SmoothDielectric;
 pub use torrance_sparrow::TorranceSparrow;
 
-use crate::color::Spectrum;
+use crate::spectrum::{RgbSample, Spectral};
 use glam::{Vec2, Vec3};
 
-/// Which part of a BSDF produced a sample.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum LobeKind {
-    /// A diffuse (Lambert / Oren–Nayar) reflection.
-    Diffuse,
-    /// A micro-facet reflection (Torrance–Sparrow, dielectric or conductor).
-    Glossy,
-    /// A micro-facet transmission through a dielectric interface.
-    Transmission,
-    /// The layer stack's multiple-internal-reflection lobe (Corrected model).
-    Multiple,
-    /// A path of the stochastic Reference random walk.
-    RandomWalk,
-}
-
-/// The lobe of a sample and the layer it comes from (0 = the top coat's interface; the base is at
-/// the index equal to the number of coats).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Lobe {
-    /// What kind of scattering.
-    pub kind: LobeKind,
-    /// Which layer of a stack (0 for single components).
-    pub layer: u8,
-}
-
-/// A sampled direction with everything an integrator needs.
-#[derive(Clone, Copy, Debug)]
-pub struct BsdfSample {
-    /// Sampled direction toward the light, local frame, unit length.
-    pub wi: Vec3,
-    /// `f(wo, wi)`, sr⁻¹, cosine excluded.
-    pub f: Spectrum,
-    /// Density of `wi` per steradian (for the Reference model an approximation, see
-    /// [`layered`]); always `> 0` in a returned sample.
-    pub pdf: f32,
-    /// Path weight `f · |wi.z| / pdf` (for the Reference model the unbiased random-walk weight).
-    pub weight: Spectrum,
-    /// Which lobe produced the sample.
-    pub lobe: Lobe,
-}
-
-impl BsdfSample {
-    /// Builds a sample from an evaluated `f` and `pdf`; `None` unless `pdf > 0` and the result is
-    /// finite, so a returned sample is always usable.
-    #[inline]
-    pub fn from_eval(wi: Vec3, f: Spectrum, pdf: f32, lobe: Lobe) -> Option<Self> {
-        if !(pdf > 0.0 && pdf.is_finite() && f.is_valid()) {
-            return None;
-        }
-        let weight = f * (wi.z.abs() / pdf);
-        weight.is_valid().then_some(BsdfSample {
-            wi,
-            f,
-            pdf,
-            weight,
-            lobe,
-        })
-    }
-}
-
-/// The interface every reflection model implements. Implementations are plain structs and closed
-/// enums (no trait objects on the hot path); the trait exists so tests and benches can be written
-/// once for all of them.
-pub trait Bxdf {
-    /// `f(wo, wi)` in sr⁻¹, cosine excluded. Zero for directions the model does not scatter into.
-    fn eval(&self, wo: Vec3, wi: Vec3) -> Spectrum;
+/// The interface every scattering model implements, generic over the transported light `S`
+/// (docs/design.md §12). Implementations are plain structs and closed enums (no trait objects on
+/// the hot path); the trait exists so the integrator, tests and benches are written once for all
+/// of them. Every model implements it for the RGB variant today; a spectral variant adds
+/// `impl Bxdf<HeroSample>` beside it, and nothing that calls the trait changes.
+///
+/// The required methods take a [`TransportMode`]; [`Bxdf::eval`] and [`Bxdf::sample`] are the
+/// radiance-mode shorthands the camera paths use.
+pub trait Bxdf<S: Spectral = RgbSample> {
+    /// The union of the flags of the model's lobes.
+    fn flags(&self) -> LobeFlags;
+    /// `f(wo, wi)` in sr⁻¹, cosine excluded, for paths carrying `mode`. Zero for directions the
+    /// model does not scatter into and for specular lobes.
+    fn eval_mode(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> S;
     /// Samples `wi` given `wo`.
     ///
     /// # Arguments
-    /// * `wo` – direction toward the viewer, local frame.
+    /// * `wo` – direction toward the viewer (radiance) or the light (importance), local frame.
     /// * `uc` – uniform number in `[0, 1]` that picks a lobe.
     /// * `u` – uniform pair in `[0, 1]²` that picks the direction within the lobe.
-    fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample>;
-    /// Density per steradian with which `sample(wo, ·)` produces `wi`.
+    /// * `mode` – what the path carries.
+    fn sample_mode(&self, wo: Vec3, uc: f32, u: Vec2, mode: TransportMode)
+    -> Option<BsdfSample<S>>;
+    /// Density per steradian with which `sample_mode(wo, ·)` produces `wi` (the same in both
+    /// modes; 0 for specular lobes).
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32;
+    /// [`Bxdf::eval_mode`] for radiance.
+    #[inline]
+    fn eval(&self, wo: Vec3, wi: Vec3) -> S {
+        self.eval_mode(wo, wi, TransportMode::Radiance)
+    }
+    /// [`Bxdf::sample_mode`] for radiance.
+    #[inline]
+    fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample<S>> {
+        self.sample_mode(wo, uc, u, TransportMode::Radiance)
+    }
 }
 
 /// Every BSDF lapidary knows, as one closed enum (static dispatch on the hot path).
@@ -131,33 +97,46 @@ pub enum Bsdf {
     OrenNayar(OrenNayar),
     /// Torrance–Sparrow reflection (dielectric or conductor).
     TorranceSparrow(TorranceSparrow),
-    /// Rough dielectric with transmission, radiance transport, both lobes.
+    /// Rough dielectric interface: reflection and transmission.
     Dielectric(RoughDielectric),
+    /// Smooth dielectric interface: mirror reflection and refraction.
+    SmoothDielectric(SmoothDielectric),
     /// A layer stack.
     Layered(Box<LayeredBsdf>),
 }
 
 impl Bxdf for Bsdf {
     #[inline]
-    fn eval(&self, wo: Vec3, wi: Vec3) -> Spectrum {
+    fn flags(&self) -> LobeFlags {
         match self {
-            Bsdf::Lambert(b) => b.eval(wo, wi),
-            Bsdf::OrenNayar(b) => b.eval(wo, wi),
-            Bsdf::TorranceSparrow(b) => b.eval(wo, wi),
-            Bsdf::Dielectric(b) => Spectrum::splat(b.eval(wo, wi, TransportMode::Radiance)),
-            Bsdf::Layered(b) => b.eval(wo, wi),
+            Bsdf::Lambert(b) => b.flags(),
+            Bsdf::OrenNayar(b) => b.flags(),
+            Bsdf::TorranceSparrow(b) => b.flags(),
+            Bsdf::Dielectric(b) => b.flags(),
+            Bsdf::SmoothDielectric(b) => b.flags(),
+            Bsdf::Layered(b) => b.flags(),
         }
     }
     #[inline]
-    fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
+    fn eval_mode(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> RgbSample {
         match self {
-            Bsdf::Lambert(b) => b.sample(wo, uc, u),
-            Bsdf::OrenNayar(b) => b.sample(wo, uc, u),
-            Bsdf::TorranceSparrow(b) => b.sample(wo, uc, u),
-            Bsdf::Dielectric(b) => {
-                b.sample(wo, uc, u, TransportMode::Radiance, dielectric::Lobes::All)
-            }
-            Bsdf::Layered(b) => b.sample(wo, uc, u),
+            Bsdf::Lambert(b) => b.eval_mode(wo, wi, mode),
+            Bsdf::OrenNayar(b) => b.eval_mode(wo, wi, mode),
+            Bsdf::TorranceSparrow(b) => b.eval_mode(wo, wi, mode),
+            Bsdf::Dielectric(b) => b.eval_mode(wo, wi, mode),
+            Bsdf::SmoothDielectric(b) => b.eval_mode(wo, wi, mode),
+            Bsdf::Layered(b) => b.eval_mode(wo, wi, mode),
+        }
+    }
+    #[inline]
+    fn sample_mode(&self, wo: Vec3, uc: f32, u: Vec2, mode: TransportMode) -> Option<BsdfSample> {
+        match self {
+            Bsdf::Lambert(b) => b.sample_mode(wo, uc, u, mode),
+            Bsdf::OrenNayar(b) => b.sample_mode(wo, uc, u, mode),
+            Bsdf::TorranceSparrow(b) => b.sample_mode(wo, uc, u, mode),
+            Bsdf::Dielectric(b) => b.sample_mode(wo, uc, u, mode),
+            Bsdf::SmoothDielectric(b) => b.sample_mode(wo, uc, u, mode),
+            Bsdf::Layered(b) => b.sample_mode(wo, uc, u, mode),
         }
     }
     #[inline]
@@ -166,7 +145,8 @@ impl Bxdf for Bsdf {
             Bsdf::Lambert(b) => b.pdf(wo, wi),
             Bsdf::OrenNayar(b) => b.pdf(wo, wi),
             Bsdf::TorranceSparrow(b) => b.pdf(wo, wi),
-            Bsdf::Dielectric(b) => b.pdf(wo, wi, dielectric::Lobes::All),
+            Bsdf::Dielectric(b) => b.pdf(wo, wi),
+            Bsdf::SmoothDielectric(b) => b.pdf(wo, wi),
             Bsdf::Layered(b) => b.pdf(wo, wi),
         }
     }
@@ -185,7 +165,7 @@ pub const F_FLUSH: f32 = 1e-30;
 
 /// Flushes channels below [`F_FLUSH`] to 0.
 #[inline]
-pub fn flush_tiny(f: Spectrum) -> Spectrum {
+pub fn flush_tiny(f: RgbSample) -> RgbSample {
     f.map(|v| if v < F_FLUSH { 0.0 } else { v })
 }
 

@@ -7,8 +7,11 @@
 //! with `cos Δφ < 0` and `tan β → ∞`); the result is clamped at 0, which is then also what `eval`
 //! reports for such directions.
 
-use super::{Bsdf, BsdfSample, Bxdf, Lobe, LobeKind, sample_cosine_hemisphere, sin2_theta};
-use crate::color::Spectrum;
+use super::{
+    Bsdf, BsdfSample, Bxdf, Lobe, LobeFlags, LobeKind, TransportMode, sample_cosine_hemisphere,
+    sin2_theta,
+};
+use crate::spectrum::RgbSample;
 use glam::{Vec2, Vec3};
 use std::f32::consts::{FRAC_1_PI, PI};
 
@@ -16,7 +19,7 @@ use std::f32::consts::{FRAC_1_PI, PI};
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct OrenNayar {
     /// Albedo ρ per channel.
-    pub albedo: Spectrum,
+    pub albedo: RgbSample,
     /// Facet slope standard deviation σ in radians.
     pub sigma: f32,
 }
@@ -58,18 +61,22 @@ impl OrenNayar {
 
 impl Bxdf for OrenNayar {
     #[inline]
-    fn eval(&self, wo: Vec3, wi: Vec3) -> Spectrum {
+    fn flags(&self) -> LobeFlags {
+        LobeFlags::REFLECTION | LobeFlags::DIFFUSE
+    }
+    #[inline]
+    fn eval_mode(&self, wo: Vec3, wi: Vec3, _mode: TransportMode) -> RgbSample {
         if wo.z <= 0.0 || wi.z <= 0.0 {
-            return Spectrum::ZERO;
+            return RgbSample::ZERO;
         }
         let (direct, inter) = self.factors(wo, wi);
         let f = self
             .albedo
             .map(|r| (r * FRAC_1_PI * (direct + r * inter)).max(0.0));
-        if f.is_finite() { f } else { Spectrum::ZERO }
+        if f.is_finite() { f } else { RgbSample::ZERO }
     }
     #[inline]
-    fn sample(&self, wo: Vec3, _uc: f32, u: Vec2) -> Option<BsdfSample> {
+    fn sample_mode(&self, wo: Vec3, _uc: f32, u: Vec2, _mode: TransportMode) -> Option<BsdfSample> {
         if wo.z <= 0.0 {
             return None;
         }
@@ -108,7 +115,7 @@ mod tests {
     #[test]
     fn sigma_zero_is_lambert() {
         let on = OrenNayar {
-            albedo: Spectrum::splat(0.8),
+            albedo: RgbSample::splat(0.8),
             sigma: 0.0,
         };
         for i in 0..9 {
@@ -121,7 +128,7 @@ mod tests {
     #[test]
     fn rough_surface_back_scatters() {
         let on = OrenNayar {
-            albedo: Spectrum::ONE,
+            albedo: RgbSample::ONE,
             sigma: 0.5,
         };
         let wo = spherical_direction(1.2, 0.0);
@@ -137,7 +144,7 @@ mod tests {
     #[test]
     fn grazing_is_finite_and_non_negative() {
         let on = OrenNayar {
-            albedo: Spectrum::ONE,
+            albedo: RgbSample::ONE,
             sigma: 1.0,
         };
         let g = Vec3::new(1.0, 0.0, 1e-7).normalize();

@@ -1,7 +1,7 @@
 //! 1-D tables over `cos θ ∈ [0, 1]`, built once per material and linearly interpolated.
 
-use crate::color::Spectrum;
 use crate::sampler::{Rng, hash_words};
+use crate::spectrum::RgbSample;
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
@@ -18,12 +18,12 @@ pub fn entry_cos(i: usize) -> f32 {
 /// A colour-valued function of `cos θ`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Table {
-    values: Box<[Spectrum]>,
+    values: Box<[RgbSample]>,
 }
 
 impl Table {
     /// A table whose entries are `f(entry_cos(i))`.
-    pub fn build(f: impl FnMut(f32) -> Spectrum) -> Self {
+    pub fn build(f: impl FnMut(f32) -> RgbSample) -> Self {
         let mut f = f;
         Table {
             values: (0..ENTRIES).map(|i| f(entry_cos(i))).collect(),
@@ -32,8 +32,8 @@ impl Table {
 
     /// A table whose entries are `f(entry_cos(i))`, computed in parallel (rayon); the result does
     /// not depend on the thread count.
-    pub fn build_par(f: impl Fn(f32) -> Spectrum + Sync) -> Self {
-        let values: Vec<Spectrum> = (0..ENTRIES)
+    pub fn build_par(f: impl Fn(f32) -> RgbSample + Sync) -> Self {
+        let values: Vec<RgbSample> = (0..ENTRIES)
             .into_par_iter()
             .map(|i| f(entry_cos(i)))
             .collect();
@@ -43,8 +43,8 @@ impl Table {
     }
 
     /// Builds two tables at once from `f(μ) -> (a, b)`, in parallel.
-    pub fn build_pair_par(f: impl Fn(f32) -> (Spectrum, Spectrum) + Sync) -> (Self, Self) {
-        let pairs: Vec<(Spectrum, Spectrum)> = (0..ENTRIES)
+    pub fn build_pair_par(f: impl Fn(f32) -> (RgbSample, RgbSample) + Sync) -> (Self, Self) {
+        let pairs: Vec<(RgbSample, RgbSample)> = (0..ENTRIES)
             .into_par_iter()
             .map(|i| f(entry_cos(i)))
             .collect();
@@ -65,11 +65,11 @@ impl Table {
     pub fn by_sampling(
         grid: usize,
         key: u64,
-        weight: impl Fn(Vec3, f32, Vec2) -> Spectrum + Sync,
+        weight: impl Fn(Vec3, f32, Vec2) -> RgbSample + Sync,
     ) -> Self {
         Table::build_par(|mu| {
             let wo = Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
-            let mut sum = Spectrum::ZERO;
+            let mut sum = RgbSample::ZERO;
             for_strata(
                 grid,
                 hash_words(&[key, u64::from(mu.to_bits())]),
@@ -82,7 +82,7 @@ impl Table {
     /// A table of zeros.
     pub fn zero() -> Self {
         Table {
-            values: vec![Spectrum::ZERO; ENTRIES].into_boxed_slice(),
+            values: vec![RgbSample::ZERO; ENTRIES].into_boxed_slice(),
         }
     }
 
@@ -96,7 +96,7 @@ impl Table {
 
     /// Linear interpolation at `cos θ` (clamped to `[0, 1]`).
     #[inline]
-    pub fn at(&self, cos: f32) -> Spectrum {
+    pub fn at(&self, cos: f32) -> RgbSample {
         let x = cos.clamp(0.0, 1.0) * (ENTRIES - 1) as f32;
         let i = (x as usize).min(ENTRIES - 2);
         let t = x - i as f32;
@@ -105,9 +105,9 @@ impl Table {
 
     /// `∫₀¹ 2 μ · table(μ) · weight(μ) dμ` by the trapezoid rule on the entries: the cosine-weighted
     /// hemispherical average of a directional quantity.
-    pub fn hemispherical(&self, weight: impl Fn(f32) -> f32) -> Spectrum {
+    pub fn hemispherical(&self, weight: impl Fn(f32) -> f32) -> RgbSample {
         let n = ENTRIES - 1;
-        let mut sum = Spectrum::ZERO;
+        let mut sum = RgbSample::ZERO;
         for i in 0..=n {
             let mu = i as f32 / n as f32;
             let w = if i == 0 || i == n { 0.5 } else { 1.0 };
@@ -146,12 +146,12 @@ mod tests {
 
     #[test]
     fn interpolates_linear_functions_exactly() {
-        let t = Table::build(|c| Spectrum::splat(2.0 * c + 1.0));
+        let t = Table::build(|c| RgbSample::splat(2.0 * c + 1.0));
         assert!((t.at(0.5)[0] - 2.0).abs() < 1e-5);
         assert!((t.at(1.0)[0] - 3.0).abs() < 1e-5);
         assert!((t.at(7.0)[0] - 3.0).abs() < 1e-5);
         // ∫ 2μ (2μ+1) dμ = 4/3 + 1.
-        let h = Table::build(|c| Spectrum::splat(2.0 * c + 1.0)).hemispherical(|_| 1.0)[0];
+        let h = Table::build(|c| RgbSample::splat(2.0 * c + 1.0)).hemispherical(|_| 1.0)[0];
         assert!((h - 7.0 / 3.0).abs() < 2e-3, "{h}");
     }
 }

@@ -12,10 +12,10 @@
 //! albedo 1 at every angle. It depends on `wo` only, so it is not reciprocal.
 
 use super::table::Table;
-use super::{Bsdf, Lobe, LobeKind, flush_tiny};
+use super::{Bsdf, Lobe, LobeFlags, LobeKind, TransportMode, flush_tiny};
 use super::{BsdfSample, Bxdf, Fresnel, MicrofacetDistribution, microfacet::v_cavity_g, reflect};
-use crate::color::Spectrum;
 use crate::sampler::hash_words;
+use crate::spectrum::RgbSample;
 use glam::{Vec2, Vec3};
 use std::sync::Arc;
 
@@ -25,7 +25,7 @@ pub struct Compensation {
     /// Single-scattering albedo at `F = 1`, over `cos θo`.
     pub e_ss: Arc<Table>,
     /// Reflectance at normal incidence.
-    pub f0: Spectrum,
+    pub f0: RgbSample,
 }
 
 /// A micro-facet reflection lobe over the upper hemisphere.
@@ -53,7 +53,9 @@ impl TorranceSparrow {
     pub fn with_compensation(mut self) -> Self {
         let plain = TorranceSparrow::new(self.distribution, Fresnel::Perfect);
         let e_ss = Table::by_sampling(32, hash_words(&[0xc0_4e05]), |wo, uc, u| {
-            plain.sample(wo, uc, u).map_or(Spectrum::ZERO, |s| s.weight)
+            plain
+                .sample(wo, uc, u)
+                .map_or(RgbSample::ZERO, |s| s.weight)
         });
         self.compensation = Some(Compensation {
             e_ss: Arc::new(e_ss),
@@ -64,12 +66,12 @@ impl TorranceSparrow {
 
     /// The compensation factor for viewing direction `wo` (1 without compensation).
     #[inline]
-    pub fn compensation_factor(&self, wo: Vec3) -> Spectrum {
+    pub fn compensation_factor(&self, wo: Vec3) -> RgbSample {
         match &self.compensation {
-            None => Spectrum::ONE,
+            None => RgbSample::ONE,
             Some(c) => {
                 let e = c.e_ss.at(wo.z)[0].clamp(1e-3, 1.0);
-                Spectrum::ONE + c.f0 * ((1.0 - e) / e)
+                RgbSample::ONE + c.f0 * ((1.0 - e) / e)
             }
         }
     }
@@ -85,21 +87,25 @@ impl TorranceSparrow {
 
 impl Bxdf for TorranceSparrow {
     #[inline]
-    fn eval(&self, wo: Vec3, wi: Vec3) -> Spectrum {
+    fn flags(&self) -> LobeFlags {
+        LobeFlags::REFLECTION | LobeFlags::GLOSSY
+    }
+    #[inline]
+    fn eval_mode(&self, wo: Vec3, wi: Vec3, _mode: TransportMode) -> RgbSample {
         if wo.z <= 0.0 || wi.z <= 0.0 {
-            return Spectrum::ZERO;
+            return RgbSample::ZERO;
         }
         let Some(h) = Self::half(wo, wi) else {
-            return Spectrum::ZERO;
+            return RgbSample::ZERO;
         };
         // Near grazing mirror pairs, rounding can tilt h past a direction: a back-facing facet
         // scatters nothing (and `pdf` is 0 there too).
         if wo.dot(h) <= 0.0 || wi.dot(h) <= 0.0 {
-            return Spectrum::ZERO;
+            return RgbSample::ZERO;
         }
         let d = self.distribution.d(h);
         if d == 0.0 {
-            return Spectrum::ZERO;
+            return RgbSample::ZERO;
         }
         let g = v_cavity_g(wo, wi, h);
         let f = self.fresnel.eval(wi.dot(h).max(0.0));
@@ -112,7 +118,7 @@ impl Bxdf for TorranceSparrow {
     }
 
     #[inline]
-    fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
+    fn sample_mode(&self, wo: Vec3, uc: f32, u: Vec2, _mode: TransportMode) -> Option<BsdfSample> {
         if wo.z <= 0.0 {
             return None;
         }
@@ -173,7 +179,7 @@ mod tests {
         let f = ts.eval(wo, wi);
         assert!(f.is_valid() && f[0] > 0.0);
         assert_eq!(ts.eval(wo, wi), ts.eval(wi, wo));
-        assert_eq!(ts.eval(wo, -wo), Spectrum::ZERO);
+        assert_eq!(ts.eval(wo, -wo), RgbSample::ZERO);
         let g = spherical_direction(1.570_796_2, 0.0);
         assert!(ts.eval(g, g).is_valid());
     }

@@ -112,7 +112,7 @@ pub fn preview_colour(stack: &StackDesc) -> [u8; 3] {
             ConductorIor::Complex { n, k } => n.zip(*k, |n, k| {
                 ((n - 1.0).powi(2) + k * k) / ((n + 1.0).powi(2) + k * k)
             }),
-            ConductorIor::Perfect => crate::color::Spectrum::ONE,
+            ConductorIor::Perfect => crate::color::Rgb::ONE,
         },
     };
     let rgb = stack.coats.iter().fold(base, |c, coat| {
@@ -315,23 +315,18 @@ mod tests {
     #[test]
     fn preview_colours_follow_base_and_tint() {
         use crate::bsdf::Coat;
-        use crate::color::Spectrum;
-        let white = StackDesc::new(
-            vec![],
-            Base::Lambert {
-                albedo: Spectrum::ONE,
-            },
-        );
+        use crate::color::Rgb;
+        let white = StackDesc::new(vec![], Base::Lambert { albedo: Rgb::ONE });
         assert_eq!(preview_colour(&white), [255, 255, 255]);
         let tinted = StackDesc::new(
             vec![Coat {
                 ior: 1.5,
                 roughness: 1.0,
-                absorption: Spectrum::rgb(0.0, 0.5, 2.0),
+                absorption: Rgb::new(0.0, 0.5, 2.0),
                 thickness: 1.0,
             }],
             Base::Lambert {
-                albedo: Spectrum::splat(0.5),
+                albedo: Rgb::splat(0.5),
             },
         );
         let [r, g, b] = preview_colour(&tinted);

@@ -19,7 +19,7 @@ pub use cabochon::Cabochon;
 pub use frame::Frame;
 pub use hit::{GeometryError, ShapeHit};
 pub use mesh::Mesh;
-pub use ray::{Ray, offset_origin};
+pub use ray::{MediumId, Ray, offset_origin};
 pub use shape::Shape;
 pub use slab::Slab;
 pub use solid::Solid;

@@ -10,13 +10,40 @@ pub struct Ray {
     pub origin: Vec3,
     /// Unit direction.
     pub dir: Vec3,
+    /// The medium the ray travels through from its origin.
+    pub medium: MediumId,
+}
+
+/// The medium a ray travels through: an index into the world's media, [`MediumId::OUTSIDE`]
+/// for the space around the stone. A transmission through a stone's surface switches between the
+/// outside and the stone's interior (docs/design.md §12).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct MediumId(pub u16);
+
+impl MediumId {
+    /// The scene's outside: vacuum or clear air, IOR 1, no extinction.
+    pub const OUTSIDE: MediumId = MediumId(0);
 }
 
 impl Ray {
-    /// A ray from `origin` along `dir` (expected unit length).
+    /// A ray from `origin` along `dir` (expected unit length), outside every medium.
     #[inline]
     pub fn new(origin: Vec3, dir: Vec3) -> Self {
-        Ray { origin, dir }
+        Ray {
+            origin,
+            dir,
+            medium: MediumId::OUTSIDE,
+        }
+    }
+
+    /// A ray from `origin` along `dir` travelling through `medium`.
+    #[inline]
+    pub fn in_medium(origin: Vec3, dir: Vec3, medium: MediumId) -> Self {
+        Ray {
+            origin,
+            dir,
+            medium,
+        }
     }
 
     /// The point at parameter `t`.

@@ -12,7 +12,7 @@
 //! [`Area::pdf`] always reproduces the density [`Area::sample`] used.
 
 use super::{LightSample, positive_or_zero};
-use crate::color::Spectrum;
+use crate::color::Rgb;
 use crate::geometry::{Frame, Ray};
 use crate::sampler::concentric_disc;
 use crate::scene::stage::{AreaLight, LightShape};
@@ -44,7 +44,7 @@ pub struct Area {
     /// `n` is the unit normal of the emitting face; for rectangles `s`, `t` follow the edges.
     frame: Frame,
     outline: Outline,
-    radiance: Spectrum,
+    radiance: Rgb,
     two_sided: bool,
     area: f32,
 }
@@ -133,12 +133,12 @@ impl Area {
 
     /// Emitted radiance toward direction `w` (unit, leaving the light): the light's radiance when
     /// `w` leaves an emitting face, else zero.
-    pub fn emitted(&self, w: Vec3) -> Spectrum {
+    pub fn emitted(&self, w: Vec3) -> Rgb {
         let c = w.dot(self.frame.n);
         if self.area > 0.0 && (c > 0.0 || (self.two_sided && c < 0.0)) {
             self.radiance
         } else {
-            Spectrum::ZERO
+            Rgb::ZERO
         }
     }
 
@@ -333,7 +333,7 @@ mod tests {
     use crate::sampler::Rng;
 
     fn light(center: Vec3, normal: Vec3, shape: LightShape, two_sided: bool) -> Area {
-        let radiance = Spectrum::splat(2.0);
+        let radiance = Rgb::splat(2.0);
         Area::new(&AreaLight {
             center,
             normal,
@@ -378,7 +378,7 @@ mod tests {
             let mut rng = Rng::new(7);
             for _ in 0..2000 {
                 let s = light.sample(p, rng.uniform2()).expect(name);
-                assert!((s.wi.length() - 1.0).abs() < 1e-5 && s.radiance == Spectrum::splat(2.0));
+                assert!((s.wi.length() - 1.0).abs() < 1e-5 && s.radiance == Rgb::splat(2.0));
                 let pdf = light.pdf(p, s.wi, s.dist);
                 assert!((pdf - s.pdf).abs() <= 1e-4 * s.pdf, "{name}: {pdf}");
                 let t = light.intersect(&Ray::new(p, s.wi), f32::INFINITY).unwrap();
@@ -441,11 +441,11 @@ mod tests {
             "in its plane"
         );
         assert!(l.sample(Vec3::ZERO, Vec2::splat(0.3)).is_some());
-        assert_eq!(l.emitted(Vec3::Y), Spectrum::ZERO);
-        assert_eq!(l.emitted(Vec3::NEG_Y), Spectrum::splat(2.0));
+        assert_eq!(l.emitted(Vec3::Y), Rgb::ZERO);
+        assert_eq!(l.emitted(Vec3::NEG_Y), Rgb::splat(2.0));
         let two = rect(Vec3::Y, 1.0, 1.0, true);
         assert!(two.sample(above, Vec2::splat(0.3)).is_some());
-        assert_eq!(two.emitted(Vec3::Y), Spectrum::splat(2.0));
+        assert_eq!(two.emitted(Vec3::Y), Rgb::splat(2.0));
         assert!((two.power() - 2.0 * l.power()).abs() < 1e-4);
         assert!((l.power() - PI * 4.0 * 2.0).abs() < 1e-4 && (l.area() - 4.0).abs() < 1e-6);
     }

@@ -24,7 +24,7 @@
 
 use super::distribution::Distribution2D;
 use super::{LightSample, positive_or_zero};
-use crate::color::Spectrum;
+use crate::color::Rgb;
 use crate::image::input_kind::NotAFile;
 use crate::image::{ImageError, RgbImage, read_rgb};
 use crate::scene::stage::Environment;
@@ -43,7 +43,7 @@ const GRADIENT_FLOOR: f32 = 0.1;
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Gradient {
     /// Radiance at y = 1, 0, −1.
-    colors: [Spectrum; 3],
+    colors: [Rgb; 3],
     /// `f` at y = 1, 0, −1.
     f: [f32; 3],
     /// `∫₋₁¹ f(y) dy`.
@@ -52,7 +52,7 @@ struct Gradient {
 
 #[derive(Clone, Debug, PartialEq)]
 enum Kind {
-    Constant(Spectrum),
+    Constant(Rgb),
     Gradient(Gradient),
     Map(Box<Map>),
 }
@@ -68,7 +68,7 @@ pub struct EnvironmentLight {
 }
 
 /// `c` with negative or non-finite channels set to 0.
-fn sanitize(c: Spectrum) -> Spectrum {
+fn sanitize(c: Rgb) -> Rgb {
     c.map(positive_or_zero)
 }
 
@@ -112,8 +112,8 @@ impl EnvironmentLight {
     }
 
     /// A gradient through `colors` at y = 1, 0, −1.
-    fn gradient(colors: [Spectrum; 3]) -> EnvironmentLight {
-        let y = colors.map(Spectrum::luminance);
+    fn gradient(colors: [Rgb; 3]) -> EnvironmentLight {
+        let y = colors.map(Rgb::luminance);
         // Mean over the sphere of a function linear in y on each hemisphere (dω = dy dφ).
         let mean = (y[0] + 2.0 * y[1] + y[2]) / 4.0;
         let f = y.map(|y| y + GRADIENT_FLOOR * mean);
@@ -158,8 +158,8 @@ impl EnvironmentLight {
             })
             .sum();
         // The same allocation, viewed as spectra.
-        let mut pixels: Vec<Spectrum> = texels.into_iter().map(Spectrum).collect();
-        pixels.resize(width * height, Spectrum::ZERO);
+        let mut pixels: Vec<Rgb> = texels.into_iter().map(Rgb).collect();
+        pixels.resize(width * height, Rgb::ZERO);
         let rows = |row: usize| {
             let (t0, t1) = (row as f32 / height as f32, (row + 1) as f32 / height as f32);
             let sin_mid = (PI * 0.5 * (t0 + t1)).sin();
@@ -266,14 +266,14 @@ impl EnvironmentLight {
 
     /// Radiance arriving from direction `dir` (unit, world space, pointing from the scene toward
     /// the sky).
-    pub fn radiance(&self, dir: Vec3) -> Spectrum {
+    pub fn radiance(&self, dir: Vec3) -> Rgb {
         match &self.kind {
             Kind::Constant(c) => *c,
             Kind::Gradient(g) => piecewise_linear(dir.y, g.colors),
-            Kind::Map(m) if m.pixels.is_empty() => Spectrum::ZERO,
+            Kind::Map(m) if m.pixels.is_empty() => Rgb::ZERO,
             Kind::Map(m) => {
                 let uv = m.uv(m.to_map(dir));
-                uv.map_or(Spectrum::ZERO, |uv| m.pixels[m.cell(uv)])
+                uv.map_or(Rgb::ZERO, |uv| m.pixels[m.cell(uv)])
             }
         }
     }

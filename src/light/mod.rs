@@ -20,7 +20,7 @@ pub use area::Area;
 pub use distribution::{Distribution1D, Distribution2D};
 pub use environment::EnvironmentLight;
 
-use crate::color::Spectrum;
+use crate::color::Rgb;
 use glam::Vec3;
 
 /// A light sample for next-event estimation.
@@ -32,7 +32,7 @@ pub struct LightSample {
     pub dist: f32,
     /// Emitted radiance arriving at the shading point along `−wi` (zero if the sampled face does
     /// not emit).
-    pub radiance: Spectrum,
+    pub radiance: Rgb,
     /// Density of `wi` per steradian (> 0, finite).
     pub pdf: f32,
 }

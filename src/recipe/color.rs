@@ -1,7 +1,7 @@
 //! Colour literals in recipes: `Rgb(r, g, b)` (linear Rec.709), `Srgb(r, g, b)` (sRGB-encoded,
 //! 0 … 1), `Hex("#rrggbb")` (sRGB-encoded) and `Gray(v)` (linear).
 
-use crate::color::Spectrum;
+use crate::color::Rgb;
 use serde::{Deserialize, Serialize};
 
 /// A colour as written in a recipe.
@@ -19,7 +19,7 @@ pub enum ColorDesc {
 
 impl ColorDesc {
     /// The linear colour, or a message saying what is wrong with the literal.
-    pub fn to_spectrum(&self) -> Result<Spectrum, String> {
+    pub fn to_rgb(&self) -> Result<Rgb, String> {
         let check = |v: [f32; 3]| {
             if v.iter().all(|c| c.is_finite()) {
                 Ok(())
@@ -30,18 +30,18 @@ impl ColorDesc {
         match self {
             ColorDesc::Rgb(r, g, b) => {
                 check([*r, *g, *b])?;
-                Ok(Spectrum::rgb(*r, *g, *b))
+                Ok(Rgb::new(*r, *g, *b))
             }
             ColorDesc::Gray(v) => {
                 check([*v; 3])?;
-                Ok(Spectrum::splat(*v))
+                Ok(Rgb::splat(*v))
             }
             ColorDesc::Srgb(r, g, b) => {
                 check([*r, *g, *b])?;
                 if [*r, *g, *b].iter().any(|c| !(0.0..=1.0).contains(c)) {
                     return Err(format!("Srgb({r}, {g}, {b}): channels must be in 0 ..= 1"));
                 }
-                Ok(Spectrum::from_srgb(*r, *g, *b))
+                Ok(Rgb::from_srgb(*r, *g, *b))
             }
             ColorDesc::Hex(s) => {
                 let h = s.strip_prefix('#').unwrap_or(s);
@@ -53,7 +53,7 @@ impl ColorDesc {
                 let byte =
                     |i: usize| u8::from_str_radix(&h[i..i + 2], 16).map(|v| f32::from(v) / 255.0);
                 match (byte(0), byte(2), byte(4)) {
-                    (Ok(r), Ok(g), Ok(b)) => Ok(Spectrum::from_srgb(r, g, b)),
+                    (Ok(r), Ok(g), Ok(b)) => Ok(Rgb::from_srgb(r, g, b)),
                     _ => Err(format!("Hex(\"{s}\"): not a hexadecimal colour")),
                 }
             }
@@ -67,14 +67,11 @@ mod tests {
 
     #[test]
     fn literals_convert() {
-        assert_eq!(
-            ColorDesc::Gray(0.5).to_spectrum().unwrap(),
-            Spectrum::splat(0.5)
-        );
-        let h = ColorDesc::Hex("#ff0080".into()).to_spectrum().unwrap();
+        assert_eq!(ColorDesc::Gray(0.5).to_rgb().unwrap(), Rgb::splat(0.5));
+        let h = ColorDesc::Hex("#ff0080".into()).to_rgb().unwrap();
         assert!((h[0] - 1.0).abs() < 1e-6 && h[1] == 0.0 && (h[2] - 0.2158).abs() < 1e-3);
-        assert!(ColorDesc::Hex("#ff00".into()).to_spectrum().is_err());
-        assert!(ColorDesc::Srgb(1.2, 0.0, 0.0).to_spectrum().is_err());
-        assert!(ColorDesc::Rgb(f32::NAN, 0.0, 0.0).to_spectrum().is_err());
+        assert!(ColorDesc::Hex("#ff00".into()).to_rgb().is_err());
+        assert!(ColorDesc::Srgb(1.2, 0.0, 0.0).to_rgb().is_err());
+        assert!(ColorDesc::Rgb(f32::NAN, 0.0, 0.0).to_rgb().is_err());
     }
 }

@@ -15,7 +15,7 @@ use super::color::ColorDesc;
 use crate::bsdf::{
     Base, Coat, ConductorIor, Distribution, FresnelMode, Metal, Model, ReferenceParams, StackDesc,
 };
-use crate::color::Spectrum;
+use crate::color::Rgb;
 use serde::{Deserialize, Serialize};
 
 /// One coat: a rough dielectric interface over a varnish layer.
@@ -183,12 +183,10 @@ impl MaterialDesc {
                     ));
                 }
                 (Some(a), None) => a
-                    .to_spectrum()
+                    .to_rgb()
                     .map_err(|e| format!("coats[{i}].absorption: {e}"))?,
                 (None, Some(t)) => {
-                    let t = t
-                        .to_spectrum()
-                        .map_err(|e| format!("coats[{i}].tint: {e}"))?;
+                    let t = t.to_rgb().map_err(|e| format!("coats[{i}].tint: {e}"))?;
                     if !(c.thickness > 0.0) {
                         return Err(format!(
                             "coats[{i}].tint needs thickness > 0 (got {})",
@@ -203,7 +201,7 @@ impl MaterialDesc {
                     }
                     t.map(|v| -v.ln() / c.thickness)
                 }
-                (None, None) => Spectrum::ZERO,
+                (None, None) => Rgb::ZERO,
             };
             coats.push(Coat {
                 ior: c.ior,
@@ -214,14 +212,10 @@ impl MaterialDesc {
         }
         let base = match &self.base {
             BaseDesc::Lambert { albedo } => Base::Lambert {
-                albedo: albedo
-                    .to_spectrum()
-                    .map_err(|e| format!("base.albedo: {e}"))?,
+                albedo: albedo.to_rgb().map_err(|e| format!("base.albedo: {e}"))?,
             },
             BaseDesc::OrenNayar { albedo, sigma } => Base::OrenNayar {
-                albedo: albedo
-                    .to_spectrum()
-                    .map_err(|e| format!("base.albedo: {e}"))?,
+                albedo: albedo.to_rgb().map_err(|e| format!("base.albedo: {e}"))?,
                 sigma: *sigma,
             },
             BaseDesc::Conductor { metal, roughness } => {
@@ -237,8 +231,8 @@ impl MaterialDesc {
                     MetalDesc::Brass => preset(Metal::Brass),
                     MetalDesc::Perfect => ConductorIor::Perfect,
                     MetalDesc::Complex { n, k } => ConductorIor::Complex {
-                        n: Spectrum::rgb(n.0, n.1, n.2),
-                        k: Spectrum::rgb(k.0, k.1, k.2),
+                        n: Rgb::new(n.0, n.1, n.2),
+                        k: Rgb::new(k.0, k.1, k.2),
                     },
                 };
                 Base::Conductor {

@@ -8,7 +8,7 @@ use super::gem::GemRecipe;
 use super::stage::{
     CameraDesc, EnvironmentDesc, FilterDesc, GroundDesc, LightDesc, SamplerDesc, ShapeDesc,
 };
-use crate::color::Spectrum;
+use crate::color::Rgb;
 use crate::scene::stage::{
     AreaLight, Camera, Environment, Filter, Ground, LightShape, Projection, SamplerKind, Shape,
     Stage, placement, rect_light,
@@ -60,7 +60,7 @@ pub(crate) fn stage(
             Some(path)
         }
     };
-    let colour = |c: &super::color::ColorDesc| c.to_spectrum().unwrap_or(Spectrum::ZERO);
+    let colour = |c: &super::color::ColorDesc| c.to_rgb().unwrap_or(Rgb::ZERO);
 
     let Some(desc) = &r.content.stage else {
         return Some(stage);

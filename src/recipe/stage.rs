@@ -75,7 +75,7 @@ pub const MAX_RADIANCE: f32 = 1e6;
 /// A colour that is emitted light: within 0 ..= [`MAX_RADIANCE`] in every channel.
 fn radiance<'de, D: Deserializer<'de>>(d: D) -> Result<ColorDesc, D::Error> {
     let c = ColorDesc::deserialize(d)?;
-    match c.to_spectrum() {
+    match c.to_rgb() {
         Ok(s) if s.0.iter().all(|v| (0.0..=MAX_RADIANCE).contains(v)) => Ok(c),
         Ok(s) => Err(serde::de::Error::custom(format!(
             "radiance {:?} is out of range: each channel allowed 0 ..= {MAX_RADIANCE:e}",
@@ -88,7 +88,7 @@ fn radiance<'de, D: Deserializer<'de>>(d: D) -> Result<ColorDesc, D::Error> {
 /// A reflectance: finite and within 0 ..= 1 in every channel.
 fn albedo<'de, D: Deserializer<'de>>(d: D) -> Result<ColorDesc, D::Error> {
     let c = ColorDesc::deserialize(d)?;
-    match c.to_spectrum() {
+    match c.to_rgb() {
         Ok(s) if s.0.iter().all(|v| (0.0..=1.0).contains(v)) => Ok(c),
         Ok(s) => Err(serde::de::Error::custom(format!(
             "albedo {:?} is out of range: each channel allowed 0 ..= 1",

@@ -2,8 +2,8 @@
 //! AOVs are read. Sums are `f64` and each pixel's samples are added in sample order by one thread,
 //! so the result does not depend on scheduling.
 
-use super::integrator::PathSample;
-use crate::color::Spectrum;
+use super::path::PathSample;
+use crate::spectrum::RgbSample;
 
 /// The accumulated samples of one pixel.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -75,9 +75,9 @@ impl PixelSums {
     }
 
     /// Mean radiance (0 without samples).
-    pub fn mean(&self) -> Spectrum {
+    pub fn mean(&self) -> RgbSample {
         let n = f64::from(self.n.max(1));
-        Spectrum(self.sum.map(|s| (s / n) as f32))
+        RgbSample(self.sum.map(|s| (s / n) as f32))
     }
 
     /// Variance of the mean per channel: the unbiased sample variance over `n` (0 below 2
@@ -172,8 +172,8 @@ mod tests {
 
     fn sample(v: f32) -> PathSample {
         PathSample {
-            radiance: Spectrum::splat(v),
-            albedo: Spectrum::splat(0.5),
+            radiance: crate::color::Rgb::splat(v),
+            albedo: crate::color::Rgb::splat(0.5),
             normal: glam::Vec3::Y,
             depth: Some(2.0),
             material: 3,

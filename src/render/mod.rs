@@ -16,18 +16,23 @@ pub mod filter;
 pub mod integrator;
 pub mod memory;
 pub mod output;
+pub mod path;
+pub mod shading;
 pub mod study;
 pub mod world;
 
 pub use camera::CameraRays;
 pub use film::{Film, PixelSums};
 pub use filter::FilterSampler;
-pub use integrator::{PathSample, Strategy, trace};
+pub use integrator::{Strategy, trace};
 pub use output::{Metadata, exr_image};
+pub use path::{PathSample, PathState};
+pub use shading::{ShadingContext, SurfaceBsdf};
 pub use world::{World, WorldError};
 
 use crate::sampler::PixelSampler;
 use crate::scene::stage::{Camera, RenderSettings};
+use crate::spectrum::RgbSample;
 use glam::Vec2;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -184,7 +189,7 @@ fn render_passes(
                             let lens = sampler.get2d();
                             let film_pt = Vec2::new(x as f32 + 0.5, y as f32 + 0.5) + offset;
                             let ray = rays.ray(film_pt, lens);
-                            let sample = trace(
+                            let sample = trace::<RgbSample>(
                                 world,
                                 ray,
                                 &mut sampler,

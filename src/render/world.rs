@@ -2,11 +2,12 @@
 //! material table, built once from a compiled [`Scene`].
 
 use crate::bsdf::{Bsdf, Bxdf, Lambert, LayeredBsdf, StackError};
-use crate::color::Spectrum;
-use crate::geometry::{GeometryError, Ray, Stone, StoneHit};
+use crate::color::Rgb;
+use crate::geometry::{GeometryError, MediumId, Ray, Stone, StoneHit};
 use crate::image::ImageError;
 use crate::light::{Area, EnvironmentLight};
 use crate::scene::{Effect, Scene};
+use crate::spectrum::RgbSample;
 use crate::texture::{Map, MapEffects};
 use glam::{Vec2, Vec3};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -125,7 +126,11 @@ pub struct World {
     /// Runtime BSDFs by material index (`None`: the map tree never uses it).
     pub materials: Vec<Option<Bsdf>>,
     /// Directional albedo at normal incidence by material index (for the albedo AOV).
-    pub albedo: Vec<Spectrum>,
+    pub albedo: Vec<Rgb>,
+    /// The medium inside the stone: what a transmission through its surface enters. Every stone
+    /// is opaque or clear today, so this is [`MediumId::OUTSIDE`]; translucent bodies (issue 17)
+    /// give it an index into the world's media.
+    pub interior: MediumId,
     /// The map tree.
     pub map: Map,
     /// Whether facet bumps apply.
@@ -172,7 +177,7 @@ impl World {
         );
         let start = Instant::now();
         let shown = AtomicBool::new(false);
-        let built: Vec<Result<Option<(Bsdf, Spectrum)>, WorldError>> = scene
+        let built: Vec<Result<Option<(Bsdf, Rgb)>, WorldError>> = scene
             .surface
             .stacks
             .par_iter()
@@ -197,7 +202,7 @@ impl World {
                 })?;
                 stack.force_absorption(scene.effects.forced(Effect::Absorption));
                 let bsdf = Bsdf::from(stack);
-                let albedo = normal_albedo(&bsdf);
+                let albedo = Rgb::from(normal_albedo(&bsdf));
                 Ok(Some((bsdf, albedo)))
             })
             .collect();
@@ -218,13 +223,18 @@ impl World {
                 }
                 None => {
                     materials.push(None);
-                    albedo.push(Spectrum::ZERO);
+                    albedo.push(Rgb::ZERO);
                 }
             }
         }
-        let ground = stage
-            .ground
-            .map(|g| (g.height, Bsdf::Lambert(Lambert { albedo: g.albedo })));
+        let ground = stage.ground.map(|g| {
+            (
+                g.height,
+                Bsdf::Lambert(Lambert {
+                    albedo: g.albedo.into(),
+                }),
+            )
+        });
         let areas: Vec<Area> = stage.lights.iter().map(Area::new).collect();
         setup.check()?;
         let mut environment = EnvironmentLight::new(&stage.environment)?;
@@ -269,6 +279,7 @@ impl World {
             light_prob,
             materials,
             albedo,
+            interior: MediumId::OUTSIDE,
             map: scene.surface.map.with_effects(MapEffects {
                 overlay: scene.effects.forced(Effect::GlitterOverlay) != Some(false),
                 blend: scene.effects.forced(Effect::StochasticSwitch) != Some(false),
@@ -345,9 +356,9 @@ impl World {
 
 /// Directional albedo at normal incidence, from a fixed stratified set of 256 samples (for the
 /// albedo AOV only).
-fn normal_albedo(bsdf: &Bsdf) -> Spectrum {
+fn normal_albedo(bsdf: &Bsdf) -> RgbSample {
     let n = 16;
-    let mut sum = Spectrum::ZERO;
+    let mut sum = RgbSample::ZERO;
     for i in 0..n {
         for j in 0..n {
             let u = Vec2::new((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32);

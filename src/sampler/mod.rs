@@ -10,9 +10,60 @@
 //! [`PixelSampler`] draws a render's numbers slot by slot: independent hashes, or Owen-scrambled
 //! Sobol' points ([`sobol`], Burley 2020), both pure functions of `(seed, pixel, sample, slot)`.
 
+//!
+//! # Slot layout (written once, here)
+//!
+//! A camera path draws its numbers from fixed *slots*, so an optional draw never shifts the meaning
+//! of a later one and every slot is its own padded Sobol' pair (the key of a slot is a hash, so
+//! slot numbers need not be contiguous and a high slot is as good as a low one):
+//!
+//! | slots | what |
+//! |---|---|
+//! | [`slots::FILM`] = 0 | position in the pixel (reconstruction filter) |
+//! | [`slots::LENS`] = 1 | point on the lens |
+//! | [`slots::bounce`]`(b)` + 0 … 5 = `2 + 6b` … | bounce `b`: map switch, light choice, light point (2-D), lobe choice, direction (2-D), Russian roulette |
+//! | [`slots::WAVELENGTH`] = 2³¹ | the path's wavelengths (drawn only by a spectral variant) |
+//! | [`slots::medium`]`(b)` = 2³¹ + 1 + `b` | the distance sample of the ray segment before bounce `b` in a medium (2-D: distance, channel) |
+//!
+//! The wavelength and medium slots live far above the bounce blocks: adding them left every
+//! number an RGB render of an opaque scene draws exactly where it was (the golden references kept
+//! their noise). They are read with [`PixelSampler::get2d_at`], which does not move the counter.
+
 pub mod pixel;
 pub mod sobol;
 pub mod warp;
+
+/// The slot layout of a camera path (module docs).
+pub mod slots {
+    /// Position in the pixel.
+    pub const FILM: u32 = 0;
+    /// Point on the lens.
+    pub const LENS: u32 = 1;
+    /// Slots per bounce.
+    pub const PER_BOUNCE: u32 = 6;
+    /// The wavelengths of a path.
+    pub const WAVELENGTH: u32 = 1 << 31;
+    /// Most bounces that own a medium slot (deeper bounces reuse the last; paths are bounded by
+    /// `max-depth ≤ 1024` anyway).
+    pub const MEDIUM_BOUNCES: u32 = 1 << 20;
+
+    /// First slot of bounce `b`'s block.
+    #[inline]
+    pub const fn bounce(b: u32) -> u32 {
+        2 + PER_BOUNCE * b
+    }
+
+    /// The medium slot of the segment before bounce `b`.
+    #[inline]
+    pub const fn medium(b: u32) -> u32 {
+        let b = if b < MEDIUM_BOUNCES {
+            b
+        } else {
+            MEDIUM_BOUNCES - 1
+        };
+        WAVELENGTH + 1 + b
+    }
+}
 
 pub use pixel::{PixelSampler, SamplerKind};
 pub use warp::concentric_disc;

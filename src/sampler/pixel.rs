@@ -69,8 +69,13 @@ impl PixelSampler {
     }
 
     #[inline]
+    fn key_of(&self, slot: u32) -> u64 {
+        mix64(self.pixel_key ^ u64::from(slot).wrapping_mul(0x9e37_79b9_7f4a_7c15))
+    }
+
+    #[inline]
     fn slot_key(&mut self) -> u64 {
-        let k = mix64(self.pixel_key ^ u64::from(self.slot).wrapping_mul(0x9e37_79b9_7f4a_7c15));
+        let k = self.key_of(self.slot);
         self.slot += 1;
         k
     }
@@ -85,6 +90,18 @@ impl PixelSampler {
     #[inline]
     pub fn get2d(&mut self) -> Vec2 {
         let key = self.slot_key();
+        self.pair(key)
+    }
+
+    /// The pair of slot `slot`, without moving the counter: for the reserved slots of
+    /// [`super::slots`] (wavelengths, medium distances) that live outside the bounce blocks.
+    #[inline]
+    pub fn get2d_at(&self, slot: u32) -> Vec2 {
+        self.pair(self.key_of(slot))
+    }
+
+    #[inline]
+    fn pair(&self, key: u64) -> Vec2 {
         match self.kind {
             SamplerKind::Independent => {
                 let a = mix64(key ^ u64::from(self.index));
@@ -135,6 +152,20 @@ mod tests {
                 !std::mem::replace(&mut seen[cell], true),
                 "cell {cell} twice"
             );
+        }
+    }
+
+    #[test]
+    fn a_reserved_slot_reads_like_any_other_and_keeps_the_counter() {
+        for kind in [SamplerKind::Independent, SamplerKind::Sobol] {
+            let mut s = PixelSampler::new(kind, 4, 9, 17);
+            let at = s.get2d_at(5);
+            s.get2d();
+            assert_eq!(s.slots_used(), 1);
+            s.skip_to(5);
+            assert_eq!(s.get2d(), at);
+            let w = s.get2d_at(super::super::slots::WAVELENGTH);
+            assert!(w != at && (0.0..1.0).contains(&w.x) && (0.0..1.0).contains(&w.y));
         }
     }
 

@@ -91,7 +91,7 @@ impl Accuracy {
         }
         if self.forced(Effect::Absorption) == Some(false) {
             for c in &mut stack.coats {
-                c.absorption = crate::color::Spectrum::ZERO;
+                c.absorption = crate::color::Rgb::ZERO;
             }
         }
     }
@@ -390,17 +390,17 @@ mod tests {
     #[test]
     fn apply_rewrites_materials() {
         use crate::bsdf::{Base, Coat};
-        use crate::color::Spectrum;
+        use crate::color::Rgb;
         let coat = Coat {
             ior: 1.5,
             roughness: 10.0,
-            absorption: Spectrum::splat(0.5),
+            absorption: Rgb::splat(0.5),
             thickness: 1.0,
         };
         let mut s = StackDesc::new(
             vec![coat],
             Base::Lambert {
-                albedo: Spectrum::splat(0.5),
+                albedo: Rgb::splat(0.5),
             },
         );
         assert_eq!(stack_calls(&s), (Some(0), false));
@@ -409,7 +409,7 @@ mod tests {
             .unwrap();
         k.accuracy.apply_to(&mut s);
         assert_eq!((s.model, s.fresnel), (Model::Course, FresnelMode::Schlick));
-        assert_eq!(s.coats[0].absorption, Spectrum::ZERO);
+        assert_eq!(s.coats[0].absorption, Rgb::ZERO);
         assert_eq!(stack_calls(&s), (None, true));
         let k: Knobs = "t-term=off".parse().unwrap();
         k.accuracy.apply_to(&mut s);

@@ -3,7 +3,7 @@
 //!
 //! World space is right-handed, y up; lengths in object units; angles stored in radians.
 
-use crate::color::Spectrum;
+use crate::color::Rgb;
 use glam::{Affine3A, EulerRot, Quat, Vec3};
 use std::path::PathBuf;
 
@@ -15,22 +15,22 @@ pub struct Ground {
     /// Height of the plane.
     pub height: f32,
     /// Reflectance.
-    pub albedo: Spectrum,
+    pub albedo: Rgb,
 }
 
 /// Light from infinitely far away.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Environment {
     /// The same radiance everywhere.
-    Constant(Spectrum),
+    Constant(Rgb),
     /// Linear in the direction's y between zenith, horizon and nadir.
     Gradient {
         /// At +y.
-        zenith: Spectrum,
+        zenith: Rgb,
         /// At y = 0.
-        horizon: Spectrum,
+        horizon: Rgb,
         /// At −y.
-        nadir: Spectrum,
+        nadir: Rgb,
     },
     /// A lat-long EXR map.
     Map {
@@ -85,7 +85,7 @@ pub struct AreaLight {
     /// Its outline.
     pub shape: LightShape,
     /// Emitted radiance (colour × intensity).
-    pub radiance: Spectrum,
+    pub radiance: Rgb,
     /// Emits from both faces.
     pub two_sided: bool,
 }
@@ -202,7 +202,7 @@ pub struct Stage {
 }
 
 /// A rectangular soft box at `center` facing `target`, `w × h`, its `w` edge horizontal.
-pub fn rect_light(center: Vec3, target: Vec3, size: (f32, f32), radiance: Spectrum) -> AreaLight {
+pub fn rect_light(center: Vec3, target: Vec3, size: (f32, f32), radiance: Rgb) -> AreaLight {
     let normal = (target - center).try_normalize().unwrap_or(Vec3::NEG_Y);
     let side = normal
         .cross(Vec3::Y)
@@ -256,31 +256,31 @@ impl Stage {
             to_world: Affine3A::IDENTITY,
             ground: Some(Ground {
                 height: 0.0,
-                albedo: Spectrum::splat(0.3),
+                albedo: Rgb::splat(0.3),
             }),
             environment: Environment::Gradient {
-                zenith: Spectrum::splat(0.08),
-                horizon: Spectrum::splat(0.05),
-                nadir: Spectrum::splat(0.02),
+                zenith: Rgb::splat(0.08),
+                horizon: Rgb::splat(0.05),
+                nadir: Rgb::splat(0.02),
             },
             lights: vec![
                 rect_light(
                     Vec3::new(-2.5, 4.0, 2.0),
                     origin,
                     (3.0, 2.0),
-                    Spectrum::splat(4.0),
+                    Rgb::splat(4.0),
                 ),
                 rect_light(
                     Vec3::new(3.5, 2.5, 1.5),
                     origin,
                     (2.0, 2.0),
-                    Spectrum::splat(1.5),
+                    Rgb::splat(1.5),
                 ),
                 rect_light(
                     Vec3::new(0.0, 3.0, -3.5),
                     origin,
                     (4.0, 1.0),
-                    Spectrum::splat(3.0),
+                    Rgb::splat(3.0),
                 ),
             ],
             camera,
@@ -304,12 +304,7 @@ mod tests {
 
     #[test]
     fn rect_lights_face_their_target_and_span_their_size() {
-        let l = rect_light(
-            Vec3::new(1.0, 3.0, 2.0),
-            Vec3::ZERO,
-            (3.0, 2.0),
-            Spectrum::ONE,
-        );
+        let l = rect_light(Vec3::new(1.0, 3.0, 2.0), Vec3::ZERO, (3.0, 2.0), Rgb::ONE);
         let LightShape::Rect { u, v } = l.shape else {
             panic!()
         };
@@ -317,7 +312,7 @@ mod tests {
         assert!((2.0 * v.length() - 3.0).abs() < 1e-5 && (2.0 * u.length() - 2.0).abs() < 1e-5);
         assert!(l.normal.dot(-l.center) > 0.0);
         // Straight down: no NaN from the parallel up vector.
-        let d = rect_light(Vec3::Y, Vec3::ZERO, (1.0, 1.0), Spectrum::ONE);
+        let d = rect_light(Vec3::Y, Vec3::ZERO, (1.0, 1.0), Rgb::ONE);
         let LightShape::Rect { u, v } = d.shape else {
             panic!()
         };

@@ -5,11 +5,12 @@ use glam::{Vec2, Vec3};
 use lapidary::bsdf::dielectric::Lobes;
 use lapidary::bsdf::measure::direction_deg;
 use lapidary::bsdf::{
-    Base, Bsdf, BsdfSample, Bxdf, Distribution, Fresnel, FresnelMode, Lambert, LayeredBsdf, Metal,
-    MicrofacetDistribution, Model, OrenNayar, RoughDielectric, TorranceSparrow, TransportMode,
+    Base, Bsdf, BsdfSample, Bxdf, Distribution, Fresnel, FresnelMode, Lambert, LayeredBsdf,
+    LobeFlags, Metal, MicrofacetDistribution, Model, OrenNayar, RoughDielectric, TorranceSparrow,
+    TransportMode,
 };
-use lapidary::color::Spectrum;
 use lapidary::recipe::MaterialLibrary;
+use lapidary::spectrum::RgbSample;
 use std::sync::Arc;
 
 /// A BSDF that can be shared by the worker threads.
@@ -79,20 +80,20 @@ pub fn component_bsdfs() -> Vec<(String, SharedBxdf, bool)> {
     };
     let diel = Fresnel::dielectric(1.5, FresnelMode::Exact);
     let (gn, gk) = Metal::Gold.nk();
-    let gold = Fresnel::conductor(gn, gk, FresnelMode::Exact);
+    let gold = Fresnel::conductor(gn.into(), gk.into(), FresnelMode::Exact);
     let shared = |b: Bsdf| -> SharedBxdf { Arc::new(b) };
     let mut v: Vec<(String, SharedBxdf, bool)> = vec![
         (
             "lambert".into(),
             shared(Bsdf::Lambert(Lambert {
-                albedo: Spectrum::rgb(0.2, 0.5, 0.9),
+                albedo: RgbSample::rgb(0.2, 0.5, 0.9),
             })),
             false,
         ),
         (
             "oren_nayar s=0.3".into(),
             shared(Bsdf::OrenNayar(OrenNayar {
-                albedo: Spectrum::rgb(0.8, 0.6, 0.3),
+                albedo: RgbSample::rgb(0.8, 0.6, 0.3),
                 sigma: 0.3,
             })),
             false,
@@ -100,7 +101,7 @@ pub fn component_bsdfs() -> Vec<(String, SharedBxdf, bool)> {
         (
             "oren_nayar s=1.0".into(),
             shared(Bsdf::OrenNayar(OrenNayar {
-                albedo: Spectrum::splat(0.9),
+                albedo: RgbSample::splat(0.9),
                 sigma: 1.0,
             })),
             false,
@@ -218,14 +219,18 @@ pub struct DielectricVariant {
 }
 
 impl Bxdf for DielectricVariant {
-    fn eval(&self, wo: Vec3, wi: Vec3) -> Spectrum {
-        Spectrum::splat(self.interface.eval(wo, wi, self.mode))
+    fn flags(&self) -> LobeFlags {
+        LobeFlags::REFLECTION | LobeFlags::TRANSMISSION | LobeFlags::GLOSSY
     }
-    fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
-        self.interface.sample(wo, uc, u, self.mode, self.lobes)
+    fn eval_mode(&self, wo: Vec3, wi: Vec3, _mode: TransportMode) -> RgbSample {
+        RgbSample::splat(self.interface.value(wo, wi, self.mode))
+    }
+    fn sample_mode(&self, wo: Vec3, uc: f32, u: Vec2, _mode: TransportMode) -> Option<BsdfSample> {
+        self.interface
+            .sample_lobes(wo, uc, u, self.mode, self.lobes)
     }
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        self.interface.pdf(wo, wi, self.lobes)
+        self.interface.pdf_lobes(wo, wi, self.lobes)
     }
 }
 

@@ -2,8 +2,8 @@
 
 use super::subjects::SharedBxdf;
 use glam::{Vec2, Vec3};
-use lapidary::bsdf::{BsdfSample, Bxdf, Lambert};
-use lapidary::color::Spectrum;
+use lapidary::bsdf::{BsdfSample, Bxdf, Lambert, LobeFlags, TransportMode};
+use lapidary::spectrum::RgbSample;
 
 /// A BSDF whose `sample` draws from one model and whose `pdf` reports another's density, or
 /// whose sampler misbehaves in a controlled way: the machinery must reject every one of them.
@@ -18,10 +18,13 @@ pub struct Wrong {
 }
 
 impl Bxdf for Wrong {
-    fn eval(&self, wo: Vec3, wi: Vec3) -> Spectrum {
+    fn flags(&self) -> LobeFlags {
+        LobeFlags::REFLECTION | LobeFlags::DIFFUSE
+    }
+    fn eval_mode(&self, wo: Vec3, wi: Vec3, _mode: TransportMode) -> RgbSample {
         self.claimed.eval(wo, wi)
     }
-    fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
+    fn sample_mode(&self, wo: Vec3, uc: f32, u: Vec2, _mode: TransportMode) -> Option<BsdfSample> {
         if uc < self.fail_share {
             return None;
         }
@@ -40,12 +43,15 @@ impl Bxdf for Wrong {
 pub struct UniformClaim;
 
 impl Bxdf for UniformClaim {
-    fn eval(&self, _wo: Vec3, wi: Vec3) -> Spectrum {
-        Spectrum::splat(if wi.z > 0.0 { 0.5 } else { 0.0 })
+    fn flags(&self) -> LobeFlags {
+        LobeFlags::REFLECTION | LobeFlags::DIFFUSE
     }
-    fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
+    fn eval_mode(&self, _wo: Vec3, wi: Vec3, _mode: TransportMode) -> RgbSample {
+        RgbSample::splat(if wi.z > 0.0 { 0.5 } else { 0.0 })
+    }
+    fn sample_mode(&self, wo: Vec3, uc: f32, u: Vec2, _mode: TransportMode) -> Option<BsdfSample> {
         Lambert {
-            albedo: Spectrum::ONE,
+            albedo: RgbSample::ONE,
         }
         .sample(wo, uc, u)
     }

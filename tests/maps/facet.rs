@@ -2,9 +2,9 @@ use crate::common::par_map;
 use crate::{K_FURNACE, alpha_i, random_unit, z_critical};
 use glam::Vec3;
 use lapidary::bsdf::{Bxdf, Lambert};
-use lapidary::color::Spectrum;
 use lapidary::geometry::frame::Frame;
 use lapidary::sampler::Rng;
+use lapidary::spectrum::RgbSample;
 use lapidary::texture::bump::{MIN_COS_WO, visible_normal};
 
 // ------------------------------------------------------------------------------------------------
@@ -98,7 +98,7 @@ const N_FURNACE: u64 = 200_000;
 fn facet_rule_gains_no_energy() {
     let geometric = Frame::from_normal(Vec3::new(0.2, -0.3, 0.93).normalize());
     let lambert = Lambert {
-        albedo: Spectrum::ONE,
+        albedo: RgbSample::ONE,
     };
     let phi_n = 0.7f32;
     let mut configs = Vec::new();

@@ -27,18 +27,18 @@ use crate::bsdf::{
     Bsdf, BsdfSample, Bxdf, Lobe, LobeKind, microfacet::v_cavity_g, refract_macro,
     sample_cosine_hemisphere,
 };
-use crate::color::Spectrum;
 use crate::sampler::hash_words;
+use crate::spectrum::RgbSample;
 use glam::{Vec2, Vec3};
 use std::f32::consts::{FRAC_1_PI, PI};
 
 /// `f(wo, wi)` of the Corrected model at stack level `l` (`l == coats` = the base).
-pub fn eval(stack: &LayeredBsdf, l: usize, wo: Vec3, wi: Vec3) -> Spectrum {
+pub fn eval(stack: &LayeredBsdf, l: usize, wo: Vec3, wi: Vec3) -> RgbSample {
     let Some(lv) = stack.levels.get(l) else {
         return stack.base.eval(wo, wi);
     };
     if wo.z <= 0.0 || wi.z <= 0.0 {
-        return Spectrum::ZERO;
+        return RgbSample::ZERO;
     }
     let mut f = lv.top.eval(wo, wi);
     let Some(wo_in) = refract_macro(wo, lv.eta) else {
@@ -73,7 +73,7 @@ pub fn eval(stack: &LayeredBsdf, l: usize, wo: Vec3, wi: Vec3) -> Spectrum {
 
 /// Evaluates level `l` under the analytic model selected by `corrected`.
 #[inline]
-fn eval_model(stack: &LayeredBsdf, l: usize, wo: Vec3, wi: Vec3, corrected: bool) -> Spectrum {
+fn eval_model(stack: &LayeredBsdf, l: usize, wo: Vec3, wi: Vec3, corrected: bool) -> RgbSample {
     if corrected {
         eval(stack, l, wo, wi)
     } else {
@@ -274,7 +274,7 @@ pub(super) fn build_tables(stack: &mut LayeredBsdf, l: usize, grid: usize) {
     let top = stack.levels[l].top.clone();
     stack.levels[l].e_top = Table::by_sampling(grid, hash_words(&[l as u64, 1]), |wo, uc, u| {
         top.sample(wo, uc, u)
-            .map_or(Spectrum::ZERO, |s| s.weight.map(|w| w.min(1e3)))
+            .map_or(RgbSample::ZERO, |s| s.weight.map(|w| w.min(1e3)))
     })
     .map(|e| e.min(1.0));
 
@@ -282,7 +282,7 @@ pub(super) fn build_tables(stack: &mut LayeredBsdf, l: usize, grid: usize) {
     let this = &*stack;
     let (albedo_rest, trapped) = Table::build_pair_par(|mu| {
         let wo_in = Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
-        let (mut a, mut q) = (Spectrum::ZERO, Spectrum::ZERO);
+        let (mut a, mut q) = (RgbSample::ZERO, RgbSample::ZERO);
         for_strata(
             grid,
             hash_words(&[l as u64, 2, u64::from(mu.to_bits())]),
@@ -300,16 +300,16 @@ pub(super) fn build_tables(stack: &mut LayeredBsdf, l: usize, grid: usize) {
     });
 
     let lv = &stack.levels[l];
-    let t_table = Table::build(|mu| Spectrum::splat(lv.t(mu)));
+    let t_table = Table::build(|mu| RgbSample::splat(lv.t(mu)));
     let r_int = (1.0 - t_table.hemispherical(|_| 1.0)[0] / (eta * eta)).clamp(0.0, 1.0);
     let rho_bar = albedo_rest
         .hemispherical(|_| 1.0)
         .map(|x| x.clamp(0.0, 1.0));
-    let denom = (Spectrum::ONE - rho_bar * r_int).map(|d| d.max(1e-6));
+    let denom = (RgbSample::ONE - rho_bar * r_int).map(|d| d.max(1e-6));
     let multi_albedo = rho_bar.zip(denom, |r, d| r * (1.0 - r_int) / d);
     // N = ∫ q(w) cos θ dω = 2π ∫₀¹ T(μ) Q(μ'(μ)) μ dμ, by the midpoint rule.
     let steps = 2048;
-    let mut q_norm = Spectrum::ZERO;
+    let mut q_norm = RgbSample::ZERO;
     for i in 0..steps {
         let mu = (i as f32 + 0.5) / steps as f32;
         let mu_in = (1.0 - (1.0 - mu * mu) / (eta * eta)).max(0.0).sqrt();

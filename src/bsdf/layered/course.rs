@@ -8,16 +8,16 @@
 
 use super::LayeredBsdf;
 use crate::bsdf::{Bxdf, microfacet::v_cavity_g, refract_macro};
-use crate::color::Spectrum;
+use crate::spectrum::RgbSample;
 use glam::Vec3;
 
 /// `f(wo, wi)` of the Course model at stack level `l` (0 = top coat; `l == coats` = the base).
-pub fn eval(stack: &LayeredBsdf, l: usize, wo: Vec3, wi: Vec3) -> Spectrum {
+pub fn eval(stack: &LayeredBsdf, l: usize, wo: Vec3, wi: Vec3) -> RgbSample {
     let Some(lv) = stack.levels.get(l) else {
         return stack.base_plain.eval(wo, wi);
     };
     if wo.z <= 0.0 || wi.z <= 0.0 {
-        return Spectrum::ZERO;
+        return RgbSample::ZERO;
     }
     let mut f = lv.top.eval(wo, wi);
     let (Some(wo_in), Some(wi_in)) = (refract_macro(wo, lv.eta), refract_macro(wi, lv.eta)) else {

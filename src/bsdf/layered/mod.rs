@@ -23,10 +23,11 @@ pub mod reference;
 
 use super::table::Table;
 use super::{
-    Bsdf, BsdfSample, Bxdf, Distribution, Fresnel, FresnelMode, Lambert, MicrofacetDistribution,
-    OrenNayar, RoughDielectric, TorranceSparrow,
+    Bsdf, BsdfSample, Bxdf, Distribution, Fresnel, FresnelMode, Lambert, LobeFlags,
+    MicrofacetDistribution, OrenNayar, RoughDielectric, TorranceSparrow, TransportMode,
 };
-use crate::color::Spectrum;
+use crate::color::Rgb;
+use crate::spectrum::RgbSample;
 use glam::{Vec2, Vec3};
 use serde::{Deserialize, Serialize};
 
@@ -38,7 +39,7 @@ pub struct Coat {
     /// RMS micro-facet slope angle of the interface, degrees (0 < m < 90).
     pub roughness: f32,
     /// Absorption coefficient per unit thickness, per channel (≥ 0).
-    pub absorption: Spectrum,
+    pub absorption: Rgb,
     /// Layer thickness in the course's arbitrary units (≥ 0).
     pub thickness: f32,
 }
@@ -49,9 +50,9 @@ pub enum ConductorIor {
     /// `n + i k` per channel.
     Complex {
         /// Real part.
-        n: Spectrum,
+        n: Rgb,
         /// Extinction coefficient.
-        k: Spectrum,
+        k: Rgb,
     },
     /// Reflectance 1 at every angle (a perfect mirror; for furnace tests).
     Perfect,
@@ -63,12 +64,12 @@ pub enum Base {
     /// Lambertian, albedo per channel.
     Lambert {
         /// Albedo (0 … 1).
-        albedo: Spectrum,
+        albedo: Rgb,
     },
     /// Oren–Nayar.
     OrenNayar {
         /// Albedo (0 … 1).
-        albedo: Spectrum,
+        albedo: Rgb,
         /// Slope standard deviation, radians.
         sigma: f32,
     },
@@ -184,7 +185,7 @@ pub(crate) struct Level {
     /// `η = 1` exactly: the interface is invisible and does not deflect light.
     pub index_matched: bool,
     /// Optical depth `α·d` at normal incidence, per channel.
-    pub od: Spectrum,
+    pub od: RgbSample,
     /// Whether the absorption code runs for this coat: when `od` is non-zero, or when the
     /// absorption effect is forced on (then a clear coat's factor is exactly 1).
     pub absorbing: bool,
@@ -195,9 +196,9 @@ pub(crate) struct Level {
     /// `Q(μ') = ∫ (1 − T_out(wi')) a f_rest cos θi' dωi'`: what the interface sends back down.
     pub trapped: Table,
     /// `M / N`: the multiple-reflection lobe's scale (see [`corrected`]).
-    pub multi_scale: Spectrum,
+    pub multi_scale: RgbSample,
     /// Fraction of `q` that leaves after the inner bounces: `ρ̄ (1 − r_int) / (1 − ρ̄ r_int)`.
-    pub multi_albedo: Spectrum,
+    pub multi_albedo: RgbSample,
 }
 
 impl Level {
@@ -209,21 +210,21 @@ impl Level {
 
     /// [`absorption`] in this coat, or 1 when its absorption code is off.
     #[inline]
-    pub fn absorb(&self, cos_a: f32, cos_b: f32) -> Spectrum {
+    pub fn absorb(&self, cos_a: f32, cos_b: f32) -> RgbSample {
         if self.absorbing {
             absorption(self.od, cos_a, cos_b)
         } else {
-            Spectrum::ONE
+            RgbSample::ONE
         }
     }
 
     /// [`transmittance`] of one leg in this coat, or 1 when its absorption code is off.
     #[inline]
-    pub fn transmit(&self, cos: f32) -> Spectrum {
+    pub fn transmit(&self, cos: f32) -> RgbSample {
         if self.absorbing {
             transmittance(self.od, cos)
         } else {
-            Spectrum::ONE
+            RgbSample::ONE
         }
     }
 }
@@ -232,14 +233,14 @@ impl Level {
 /// (never NaN) when the optical depth is huge or a leg is grazing, and exactly 1 for `α d = 0`
 /// (the path length is at most `2·10¹²`, so `0 · path = 0`).
 #[inline]
-pub fn absorption(od: Spectrum, cos_a: f32, cos_b: f32) -> Spectrum {
+pub fn absorption(od: RgbSample, cos_a: f32, cos_b: f32) -> RgbSample {
     let path = 1.0 / cos_a.abs().max(1e-12) + 1.0 / cos_b.abs().max(1e-12);
     od.map(|o| (-o * path).exp())
 }
 
 /// Transmittance of one inner leg, `exp(−α d / |cos θ|)`; exactly 1 for `α d = 0`.
 #[inline]
-pub fn transmittance(od: Spectrum, cos: f32) -> Spectrum {
+pub fn transmittance(od: RgbSample, cos: f32) -> RgbSample {
     let path = 1.0 / cos.abs().max(1e-12);
     od.map(|o| (-o * path).exp())
 }
@@ -280,24 +281,31 @@ impl LayeredBsdf {
                 fresnel: Fresnel::dielectric(eta, desc.fresnel),
                 interface: RoughDielectric::new(dist, eta),
                 index_matched: (eta - 1.0).abs() < 1e-6,
-                od: c.absorption * c.thickness,
-                absorbing: (c.absorption * c.thickness).max_channel() > 0.0,
+                od: RgbSample::from(c.absorption) * c.thickness,
+                absorbing: (RgbSample::from(c.absorption) * c.thickness).max_channel() > 0.0,
                 e_top: Table::zero(),
                 albedo_rest: Table::zero(),
                 trapped: Table::zero(),
-                multi_scale: Spectrum::ZERO,
-                multi_albedo: Spectrum::ZERO,
+                multi_scale: RgbSample::ZERO,
+                multi_albedo: RgbSample::ZERO,
             });
         }
         let base = match desc.base {
-            Base::Lambert { albedo } => Bsdf::Lambert(Lambert { albedo }),
-            Base::OrenNayar { albedo, sigma } => Bsdf::OrenNayar(OrenNayar { albedo, sigma }),
+            Base::Lambert { albedo } => Bsdf::Lambert(Lambert {
+                albedo: albedo.into(),
+            }),
+            Base::OrenNayar { albedo, sigma } => Bsdf::OrenNayar(OrenNayar {
+                albedo: albedo.into(),
+                sigma,
+            }),
             Base::Conductor { ior, roughness } => {
                 let fresnel = match ior {
                     ConductorIor::Perfect => Fresnel::Perfect,
-                    ConductorIor::Complex { n, k } => {
-                        Fresnel::conductor(n / above, k / above, desc.fresnel)
-                    }
+                    ConductorIor::Complex { n, k } => Fresnel::conductor(
+                        RgbSample::from(n) / above,
+                        RgbSample::from(k) / above,
+                        desc.fresnel,
+                    ),
                 };
                 Bsdf::TorranceSparrow(TorranceSparrow::new(
                     MicrofacetDistribution::new(desc.distribution, roughness),
@@ -418,7 +426,7 @@ pub fn validate(desc: &StackDesc) -> Result<(), StackError> {
             }
         }
     }
-    let check_albedo = |albedo: Spectrum| {
+    let check_albedo = |albedo: Rgb| {
         for ch in 0..3 {
             if !(0.0..=1.0).contains(&albedo[ch]) {
                 return bad(format!("base.albedo[{ch}]"), albedo[ch], "0 ..= 1");
@@ -460,7 +468,16 @@ pub fn validate(desc: &StackDesc) -> Result<(), StackError> {
 
 impl Bxdf for LayeredBsdf {
     #[inline]
-    fn eval(&self, wo: Vec3, wi: Vec3) -> Spectrum {
+    fn flags(&self) -> LobeFlags {
+        // Every lobe of a stack reflects; the Reference walk is glossy, the analytic models
+        // mix glossy coats with the base's spread.
+        match self.model {
+            Model::Reference(_) => LobeFlags::REFLECTION | LobeFlags::GLOSSY,
+            _ => self.base.flags() | LobeFlags::GLOSSY,
+        }
+    }
+    #[inline]
+    fn eval_mode(&self, wo: Vec3, wi: Vec3, _mode: TransportMode) -> RgbSample {
         super::flush_tiny(match self.model {
             Model::Course => course::eval(self, 0, wo, wi),
             Model::Corrected => corrected::eval(self, 0, wo, wi),
@@ -468,7 +485,7 @@ impl Bxdf for LayeredBsdf {
         })
     }
     #[inline]
-    fn sample(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample> {
+    fn sample_mode(&self, wo: Vec3, uc: f32, u: Vec2, _mode: TransportMode) -> Option<BsdfSample> {
         match self.model {
             Model::Course => corrected::sample(self, 0, wo, uc, u, false),
             Model::Corrected => corrected::sample(self, 0, wo, uc, u, true),

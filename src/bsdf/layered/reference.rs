@@ -24,8 +24,8 @@
 use super::{LayeredBsdf, ReferenceParams, corrected};
 use crate::bsdf::dielectric::Lobes;
 use crate::bsdf::{BsdfSample, Bxdf, Lobe, LobeKind, TransportMode, power_heuristic};
-use crate::color::Spectrum;
 use crate::sampler::{Rng, hash_f32s};
+use crate::spectrum::RgbSample;
 use glam::{Vec2, Vec3};
 use std::f32::consts::FRAC_1_PI;
 
@@ -36,7 +36,7 @@ const COSINE_MIX: f32 = 0.1;
 const RR_DEPTH: u32 = 3;
 
 /// `f(wo, wi)` of the Reference model.
-pub fn eval(stack: &LayeredBsdf, p: ReferenceParams, wo: Vec3, wi: Vec3) -> Spectrum {
+pub fn eval(stack: &LayeredBsdf, p: ReferenceParams, wo: Vec3, wi: Vec3) -> RgbSample {
     let mut rng = Rng::new(hash_f32s(&[wo.x, wo.y, wo.z, wi.x, wi.y, wi.z]));
     eval_at(stack, p, 0, wo, wi, &mut rng)
 }
@@ -67,15 +67,21 @@ pub fn sample(
         return None;
     }
     let f = weight * (pdf / wi.z);
+    let lobe = Lobe {
+        kind: LobeKind::RandomWalk,
+        layer: 0,
+    };
     Some(BsdfSample {
         wi,
         f,
         pdf,
         weight,
-        lobe: Lobe {
-            kind: LobeKind::RandomWalk,
-            layer: 0,
-        },
+        lobe,
+        flags: lobe.kind.flags(),
+        eta: 1.0,
+        // The walk's density has no closed form: `pdf` is the mixture approximation of
+        // [`pdf`], proportional in spirit only.
+        pdf_is_proportional: true,
     })
 }
 
@@ -97,12 +103,12 @@ fn eval_at(
     wo: Vec3,
     wi: Vec3,
     rng: &mut Rng,
-) -> Spectrum {
+) -> RgbSample {
     let Some(lv) = stack.levels.get(l) else {
         return stack.base.eval(wo, wi);
     };
     if wo.z <= 0.0 || wi.z <= 0.0 {
-        return Spectrum::ZERO;
+        return RgbSample::ZERO;
     }
     if lv.index_matched {
         // An invisible interface: straight through, absorption both ways.
@@ -111,10 +117,10 @@ fn eval_at(
     }
     let iface = &lv.interface;
     let f_top =
-        Spectrum::splat(iface.eval(wo, wi, TransportMode::Radiance) * iface.compensation(wo));
-    let mut acc = Spectrum::ZERO;
+        RgbSample::splat(iface.value(wo, wi, TransportMode::Radiance) * iface.compensation(wo));
+    let mut acc = RgbSample::ZERO;
     for _ in 0..p.samples {
-        let Some(wos) = iface.sample(
+        let Some(wos) = iface.sample_lobes(
             wo,
             rng.uniform(),
             rng.uniform2(),
@@ -123,7 +129,7 @@ fn eval_at(
         ) else {
             continue;
         };
-        let Some(wis) = iface.sample(
+        let Some(wis) = iface.sample_lobes(
             wi,
             rng.uniform(),
             rng.uniform2(),
@@ -163,15 +169,15 @@ fn eval_at(
             beta *= wtb;
             w = wb; // travelling up
             // Strategy B: evaluate the interface's transmission toward wi.
-            let fe = iface.eval(-w, wi, TransportMode::Radiance) * iface.compensation(-w);
+            let fe = iface.value(-w, wi, TransportMode::Radiance) * iface.compensation(-w);
             if fe > 0.0 {
-                let pa = iface.pdf(wi, -w, Lobes::Transmission);
+                let pa = iface.pdf_lobes(wi, -w, Lobes::Transmission);
                 let wt = power_heuristic(pdf_b, pa);
                 acc += beta * lv.transmit(w.z) * (fe * wt);
             }
             beta *= lv.transmit(w.z);
             // Internal reflection back down at the interface.
-            let Some(rs) = iface.sample(
+            let Some(rs) = iface.sample_lobes(
                 -w,
                 rng.uniform(),
                 rng.uniform2(),
@@ -188,7 +194,7 @@ fn eval_at(
         }
     }
     let f = f_top + acc / p.samples as f32;
-    if f.is_valid() { f } else { Spectrum::ZERO }
+    if f.is_valid() { f } else { RgbSample::ZERO }
 }
 
 /// Samples the bottom of a level: the base exactly, or a deeper walk. Returns the direction, the
@@ -199,7 +205,7 @@ fn sample_bottom(
     l: usize,
     wo: Vec3,
     rng: &mut Rng,
-) -> Option<(Vec3, Spectrum, f32)> {
+) -> Option<(Vec3, RgbSample, f32)> {
     if l == stack.levels.len() {
         let s = stack.base.sample(wo, rng.uniform(), rng.uniform2())?;
         return Some((s.wi, s.weight, s.pdf));
@@ -218,7 +224,7 @@ fn walk_at(
     wo: Vec3,
     first: Option<(f32, Vec2)>,
     rng: &mut Rng,
-) -> Option<(Vec3, Spectrum)> {
+) -> Option<(Vec3, RgbSample)> {
     let Some(lv) = stack.levels.get(l) else {
         let (uc, u) = first.unwrap_or_else(|| (rng.uniform(), rng.uniform2()));
         let s = stack.base.sample(wo, uc, u)?;
@@ -230,7 +236,7 @@ fn walk_at(
     }
     let iface = &lv.interface;
     let (uc, u) = first.unwrap_or_else(|| (rng.uniform(), rng.uniform2()));
-    let s = iface.sample(wo, uc, u, TransportMode::Radiance, Lobes::All)?;
+    let s = iface.sample_lobes(wo, uc, u, TransportMode::Radiance, Lobes::All)?;
     let c = iface.compensation(wo);
     if s.wi.z > 0.0 {
         return Some((s.wi, s.weight * c));
@@ -248,7 +254,7 @@ fn walk_at(
         beta *= lv.transmit(w.z);
         let (wb, wtb, _) = sample_bottom(stack, p, l + 1, -w, rng)?;
         beta *= wtb * lv.transmit(wb.z);
-        let s = iface.sample(
+        let s = iface.sample_lobes(
             -wb,
             rng.uniform(),
             rng.uniform2(),

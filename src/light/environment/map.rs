@@ -2,7 +2,7 @@
 //! the checks that refuse a map no light can be made of. The direction convention is in the
 //! parent module's docs.
 
-use crate::color::Spectrum;
+use crate::color::Rgb;
 use crate::image::{ImageError, RgbImage};
 use crate::light::distribution::Distribution2D;
 use glam::{Vec2, Vec3};
@@ -14,7 +14,7 @@ pub(super) struct Map {
     pub(super) width: usize,
     pub(super) height: usize,
     /// Radiance per pixel, intensity applied, invalid values zeroed; row-major, top row first.
-    pub(super) pixels: Vec<Spectrum>,
+    pub(super) pixels: Vec<Rgb>,
     pub(super) distribution: Distribution2D,
     /// `cos α`, `sin α` of the rotation about +y.
     pub(super) rotation: Vec2,

@@ -30,18 +30,18 @@ fn textured(rotate: f32) -> EnvironmentLight {
 }
 
 fn gradient() -> EnvironmentLight {
-    let (zenith, horizon) = (Spectrum::rgb(0.2, 0.4, 1.0), Spectrum::splat(0.8));
+    let (zenith, horizon) = (Rgb::new(0.2, 0.4, 1.0), Rgb::splat(0.8));
     EnvironmentLight::new(&Environment::Gradient {
         zenith,
         horizon,
-        nadir: Spectrum::ZERO,
+        nadir: Rgb::ZERO,
     })
     .expect("no file")
 }
 
 #[test]
 fn pdf_matches_sample_and_integrates_to_one() {
-    let constant = EnvironmentLight::new(&Environment::Constant(Spectrum::splat(0.3)));
+    let constant = EnvironmentLight::new(&Environment::Constant(Rgb::splat(0.3)));
     let lights = [constant.expect("no file"), gradient(), textured(0.7)];
     for (name, l) in ["constant", "gradient", "map"].into_iter().zip(lights) {
         let mut rng = Rng::new(9);
@@ -74,9 +74,9 @@ fn gradient_is_linear_in_height_and_estimates_its_integral() {
     let (zenith, horizon) = (l.radiance(Vec3::Y), l.radiance(Vec3::X));
     assert_eq!(
         (zenith, horizon),
-        (Spectrum::rgb(0.2, 0.4, 1.0), Spectrum::splat(0.8))
+        (Rgb::new(0.2, 0.4, 1.0), Rgb::splat(0.8))
     );
-    assert_eq!(l.radiance(Vec3::NEG_Y), Spectrum::ZERO);
+    assert_eq!(l.radiance(Vec3::NEG_Y), Rgb::ZERO);
     assert!((l.radiance(Vec3::new(0.0, -0.5, 0.866))[0] - 0.4).abs() < 1e-6);
     // ∫ L dω = π (zenith + 2 horizon + nadir) per channel, within 4 standard errors.
     for ch in 0..3 {
@@ -159,21 +159,18 @@ fn invalid_and_black_maps_are_handled() {
     let mut rng = Rng::new(1);
     for _ in 0..500 {
         let s = l.sample(rng.uniform2()).unwrap();
-        assert_eq!(s.radiance, Spectrum::splat(2.0), "never an invalid pixel");
+        assert_eq!(s.radiance, Rgb::splat(2.0), "never an invalid pixel");
     }
-    assert_eq!(
-        l.radiance(Vec3::new(-0.1, 0.9, 0.0).normalize()),
-        Spectrum::ZERO
-    );
+    assert_eq!(l.radiance(Vec3::new(-0.1, 0.9, 0.0).normalize()), Rgb::ZERO);
     for l in [
         EnvironmentLight::from_image(&spot(4, 2, 0..0, 0..0, 1.0), 1.0, 0.0),
         EnvironmentLight::from_image(&img, 0.0, 0.0),
         EnvironmentLight::from_image(&spot(0, 0, 0..1, 0..1, 1.0), 1.0, 0.0),
-        EnvironmentLight::new(&Environment::Constant(Spectrum::ZERO)).unwrap(),
+        EnvironmentLight::new(&Environment::Constant(Rgb::ZERO)).unwrap(),
     ] {
         assert!(l.is_black() && l.sample(Vec2::splat(0.5)).is_none());
         assert_eq!((l.pdf(Vec3::X), l.power(1.0)), (0.0, 0.0));
-        assert_eq!(l.radiance(Vec3::X), Spectrum::ZERO);
+        assert_eq!(l.radiance(Vec3::X), Rgb::ZERO);
     }
 }
 

@@ -1,0 +1,160 @@
+//! The state a camera path carries from vertex to vertex (replaces the loose locals of the path
+//! loop; the loop itself is [`super::integrator`]).
+
+use crate::bsdf::{BsdfSample, LobeFlags};
+use crate::color::Rgb;
+use crate::geometry::MediumId;
+use crate::spectrum::Spectral;
+use glam::Vec3;
+
+/// Radiance and first-hit data of one camera path.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PathSample {
+    /// Radiance along the camera ray, as the film stores it.
+    pub radiance: Rgb,
+    /// Albedo at the first hit (0 where the ray leaves the scene or meets a light).
+    pub albedo: Rgb,
+    /// World shading normal at the first hit (facet normal on glitter), 0 if none.
+    pub normal: Vec3,
+    /// Distance to the first hit along the camera ray, if any.
+    pub depth: Option<f32>,
+    /// Material index at the first hit: ≥ 0 the stone's material, −1 the floor, −2 nothing or a
+    /// light.
+    pub material: i32,
+    /// Rays traced (camera, extension and shadow rays).
+    pub rays: u32,
+}
+
+/// The scattering event that produced the current ray (for the MIS weight of emission the ray
+/// reaches).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PrevVertex {
+    /// Density per steradian of the sampled direction.
+    pub pdf: f32,
+    /// The point the ray left.
+    pub p: Vec3,
+    /// The sampled lobe: a specular lobe has no density, so emission it reaches takes weight 1.
+    pub flags: LobeFlags,
+}
+
+/// Everything a path knows between two vertices, generic over the transported light `S`.
+#[derive(Clone, Copy, Debug)]
+pub struct PathState<S: Spectral> {
+    /// Throughput `β`: the product of `f |cos| / pdf` so far, divided by the roulette
+    /// probabilities.
+    pub beta: S,
+    /// Radiance gathered so far.
+    pub l: S,
+    /// The product of `η²` of the refractions so far (pbrt-v4 §14.1.5): Russian roulette looks at
+    /// `β · eta_scale`, which removes the radiance compression of entering a denser medium.
+    pub eta_scale: f32,
+    /// The medium the current ray travels through.
+    pub medium: MediumId,
+    /// The path's wavelengths (zero-sized in the RGB variant).
+    pub lambda: S::Wavelengths,
+    /// Scattering events so far.
+    pub depth: u32,
+    /// The event that produced the current ray; `None` for the camera ray.
+    pub prev: Option<PrevVertex>,
+}
+
+impl<S: Spectral> PathState<S> {
+    /// A camera path carrying `lambda`, starting in `medium`.
+    pub fn new(lambda: S::Wavelengths, medium: MediumId) -> Self {
+        PathState {
+            beta: S::ONE,
+            l: S::ZERO,
+            eta_scale: 1.0,
+            medium,
+            lambda,
+            depth: 0,
+            prev: None,
+        }
+    }
+
+    /// Adds emitted radiance `le` reaching the path with MIS weight `w`.
+    #[inline]
+    pub fn add_emission(&mut self, le: S, w: f32) {
+        self.l += self.beta * le * w;
+    }
+
+    /// Takes the scattering event `bs` at `p`: multiplies the throughput, records the vertex and,
+    /// for a refraction, its `η²` and the medium crossed into.
+    ///
+    /// # Arguments
+    /// * `inside` – the medium on the far side of the surface when the path crosses it from
+    ///   `MediumId::OUTSIDE` (a crossing from any other medium returns to the outside).
+    #[inline]
+    pub fn scatter(&mut self, bs: &BsdfSample<S>, p: Vec3, inside: MediumId) {
+        self.beta *= bs.weight;
+        if bs.flags.is_transmission() {
+            self.eta_scale *= bs.eta * bs.eta;
+            self.medium = if self.medium == MediumId::OUTSIDE {
+                inside
+            } else {
+                MediumId::OUTSIDE
+            };
+        }
+        self.depth += 1;
+        self.prev = Some(PrevVertex {
+            pdf: bs.pdf,
+            p,
+            flags: bs.flags,
+        });
+    }
+
+    /// The survival probability of Russian roulette, `min(1, max β·eta_scale)`.
+    #[inline]
+    pub fn survival(&self) -> f32 {
+        (self.beta * self.eta_scale).max_channel().min(1.0)
+    }
+
+    /// False once the throughput is zero or invalid: the path carries nothing more.
+    #[inline]
+    pub fn alive(&self) -> bool {
+        self.beta.is_valid() && !self.beta.is_black()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bsdf::{Lobe, LobeKind};
+    use crate::spectrum::{RgbSample, RgbWavelengths};
+
+    fn sample(kind: LobeKind, weight: f32, eta: f32) -> BsdfSample {
+        BsdfSample::from_eval(
+            Vec3::Z,
+            RgbSample::splat(weight),
+            1.0,
+            Lobe { kind, layer: 0 },
+        )
+        .unwrap()
+        .with_eta(eta)
+    }
+
+    #[test]
+    fn refraction_switches_medium_and_keeps_roulette_fair() {
+        let inside = MediumId(3);
+        let mut p = PathState::<RgbSample>::new(RgbWavelengths, MediumId::OUTSIDE);
+        // Entering glass in radiance mode: weight (1 − F)/η² ≈ 0.96/2.25.
+        p.scatter(
+            &sample(LobeKind::Transmission, 0.96 / 2.25, 1.5),
+            Vec3::ZERO,
+            inside,
+        );
+        assert_eq!(p.medium, inside);
+        assert!((p.survival() - 0.96).abs() < 1e-5, "{}", p.survival());
+        p.scatter(&sample(LobeKind::Glossy, 0.5, 1.0), Vec3::ZERO, inside);
+        assert_eq!(p.medium, inside, "a reflection stays inside");
+        p.scatter(
+            &sample(LobeKind::Transmission, 1.0, 1.0 / 1.5),
+            Vec3::ONE,
+            inside,
+        );
+        assert_eq!(p.medium, MediumId::OUTSIDE);
+        assert!((p.eta_scale - 1.0).abs() < 1e-6);
+        assert_eq!(p.depth, 3);
+        assert_eq!(p.prev.unwrap().p, Vec3::ONE);
+    }
+}

@@ -1,0 +1,202 @@
+//! The BSDF at a hit, built from a shading context: the hit's position, normals and facet and the
+//! path's wavelengths go in, a [`SurfaceBsdf`] — a material's scattering model in the hit's
+//! shading frame — comes out. This is the one place a spectral variant builds per-wavelength
+//! BSDF values (docs/design.md §12); the RGB variant borrows the material's prebuilt model.
+
+use super::path::PathSample;
+use super::world::{Hit, World};
+use crate::bsdf::{Bsdf, BsdfSample, Bxdf, LobeFlags, TransportMode};
+use crate::geometry::{Frame, MediumId};
+use crate::spectrum::Spectral;
+use crate::texture::bump::facet_frame;
+use glam::{Vec2, Vec3};
+
+/// What is known about a surface hit before its BSDF is built.
+#[derive(Clone, Copy, Debug)]
+pub struct ShadingContext<W> {
+    /// Hit point, world space.
+    pub p: Vec3,
+    /// Geometric normal, facing the incoming direction `wo`.
+    pub ng: Vec3,
+    /// Unbumped shading normal, facing `wo`.
+    pub ns: Vec3,
+    /// Facet normal the map chose (world space), if any.
+    pub facet: Option<Vec3>,
+    /// Material index of the stone's map, `None` for the floor.
+    pub material: Option<u32>,
+    /// The path's wavelengths.
+    pub lambda: W,
+}
+
+/// A material's scattering model placed at a hit: local-frame BSDF plus the frame and normals
+/// that decide which world directions it may scatter into.
+#[derive(Clone, Copy, Debug)]
+pub struct SurfaceBsdf<'a> {
+    /// Hit point, world space.
+    pub p: Vec3,
+    /// Geometric normal, facing `wo`.
+    pub ng: Vec3,
+    /// Unbumped shading normal, facing `wo`.
+    pub ns: Vec3,
+    /// The shading frame (the facet's frame on a faceted cell).
+    pub frame: Frame,
+    /// The medium behind the surface (what a transmission from outside enters).
+    pub inside: MediumId,
+    bxdf: &'a Bsdf,
+    flags: LobeFlags,
+}
+
+impl<'a> SurfaceBsdf<'a> {
+    /// The lobes of the model.
+    #[inline]
+    pub fn flags(&self) -> LobeFlags {
+        self.flags
+    }
+
+    /// Whether world direction `wi` may carry light to or from `wo` (facing `ng`): on the front of
+    /// both the geometric and the unbumped shading surface for reflection, on the back of both for
+    /// transmission (the rule of [`crate::texture::bump`], so a facet never gains energy).
+    #[inline]
+    pub fn admits(&self, wi: Vec3) -> bool {
+        let (g, s) = (wi.dot(self.ng), wi.dot(self.ns));
+        (g > 0.0 && s > 0.0) || (self.flags.is_transmission() && g < 0.0 && s < 0.0)
+    }
+
+    /// `f(wo, wi)` for world directions, sr⁻¹.
+    #[inline]
+    pub fn eval<S: Spectral>(&self, wo_local: Vec3, wi: Vec3) -> (Vec3, S)
+    where
+        Bsdf: Bxdf<S>,
+    {
+        let wi_local = self.frame.to_local(wi);
+        (
+            wi_local,
+            self.bxdf
+                .eval_mode(wo_local, wi_local, TransportMode::Radiance),
+        )
+    }
+
+    /// Density of `wi_local` (local frame) from `wo_local`.
+    #[inline]
+    pub fn pdf<S: Spectral>(&self, wo_local: Vec3, wi_local: Vec3) -> f32
+    where
+        Bsdf: Bxdf<S>,
+    {
+        <Bsdf as Bxdf<S>>::pdf(self.bxdf, wo_local, wi_local)
+    }
+
+    /// Samples a direction in radiance mode; the sample's `wi` is returned in world space (unit
+    /// length) and `None` unless the surface admits it.
+    #[inline]
+    pub fn sample<S: Spectral>(&self, wo_local: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample<S>>
+    where
+        Bsdf: Bxdf<S>,
+    {
+        let mut bs = self
+            .bxdf
+            .sample_mode(wo_local, uc, u, TransportMode::Radiance)?;
+        bs.wi = self.frame.to_world(bs.wi).normalize();
+        self.admits(bs.wi).then_some(bs)
+    }
+}
+
+/// Builds the BSDF of a stone or floor hit for the incoming direction `wo` (world, toward the
+/// viewer); records the first-hit AOVs when `first`. `None` for a light or an unused material.
+///
+/// # Arguments
+/// * `u_switch` – the bounce's map-switch number (stochastic blends of the map tree).
+/// * `lambda` – the path's wavelengths.
+pub fn shade<'a, W: Copy>(
+    world: &'a World,
+    hit: &Hit,
+    wo: Vec3,
+    u_switch: f32,
+    lambda: W,
+    first: bool,
+    out: &mut PathSample,
+) -> Option<SurfaceBsdf<'a>> {
+    let t_hit;
+    let ctx = match *hit {
+        Hit::Stone(h) => {
+            // Meshes may be open or wound inconsistently: face the normals toward the viewer.
+            let (ng, ns) = if wo.dot(h.ng) < 0.0 {
+                (-h.ng, -h.ns)
+            } else {
+                (h.ng, h.ns)
+            };
+            let ns = if wo.dot(ns) > 0.0 { ns } else { ng };
+            let look = world.map.lookup(h.p_object, u_switch);
+            t_hit = h.t;
+            ShadingContext {
+                p: h.p,
+                ng,
+                ns,
+                facet: look.facet,
+                material: Some(look.material),
+                lambda,
+            }
+        }
+        Hit::Ground { t, p } => {
+            let n = if wo.y >= 0.0 { Vec3::Y } else { Vec3::NEG_Y };
+            t_hit = t;
+            ShadingContext {
+                p,
+                ng: n,
+                ns: n,
+                facet: None,
+                material: None,
+                lambda,
+            }
+        }
+        Hit::Light { .. } => return None,
+    };
+    let sb = world.bsdf_at(&ctx, wo)?;
+    if first {
+        out.depth = Some(t_hit);
+        match ctx.material {
+            Some(m) => {
+                out.albedo = world.albedo[m as usize];
+                out.material = m as i32;
+            }
+            None => {
+                if let Bsdf::Lambert(b) = sb.bxdf {
+                    out.albedo = b.albedo.into();
+                }
+                out.material = -1;
+            }
+        }
+        out.normal = sb.frame.n;
+    }
+    Some(sb)
+}
+
+impl World {
+    /// The BSDF at a hit described by `ctx`, for the incoming direction `wo` (world, toward the
+    /// viewer); `None` when the material is unused or there is no floor.
+    pub fn bsdf_at<W>(&self, ctx: &ShadingContext<W>, wo: Vec3) -> Option<SurfaceBsdf<'_>> {
+        let (bxdf, frame, inside) = match ctx.material {
+            Some(m) => {
+                let bxdf = self.materials.get(m as usize)?.as_ref()?;
+                let base = Frame::from_normal(ctx.ns);
+                let frame = match ctx.facet {
+                    Some(facet) if self.facet_bump => facet_frame(&base, facet, wo),
+                    _ => base,
+                };
+                (bxdf, frame, self.interior)
+            }
+            None => {
+                let (_, bxdf) = self.ground.as_ref()?;
+                (bxdf, Frame::from_normal(ctx.ns), MediumId::OUTSIDE)
+            }
+        };
+        Some(SurfaceBsdf {
+            p: ctx.p,
+            ng: ctx.ng,
+            ns: ctx.ns,
+            frame,
+            inside,
+            bxdf,
+            flags: bxdf.flags(),
+        })
+    }
+}
