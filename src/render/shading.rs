@@ -24,6 +24,9 @@ pub struct ShadingContext<W> {
     pub facet: Option<Vec3>,
     /// Material index of the stone's map, `None` for the floor.
     pub material: Option<u32>,
+    /// True when `wo` is on the side the surface's own normal points to (the outside of a closed,
+    /// consistently wound stone); `ng` and `ns` are flipped to face `wo` either way.
+    pub front: bool,
     /// The path's wavelengths.
     pub lambda: W,
 }
@@ -119,7 +122,8 @@ pub fn shade<'a, W: Copy>(
     let ctx = match *hit {
         Hit::Stone(h) => {
             // Meshes may be open or wound inconsistently: face the normals toward the viewer.
-            let (ng, ns) = if wo.dot(h.ng) < 0.0 {
+            let front = wo.dot(h.ng) >= 0.0;
+            let (ng, ns) = if !front {
                 (-h.ng, -h.ns)
             } else {
                 (h.ng, h.ns)
@@ -133,6 +137,7 @@ pub fn shade<'a, W: Copy>(
                 ns,
                 facet: look.facet,
                 material: Some(look.material),
+                front,
                 lambda,
             }
         }
@@ -145,6 +150,7 @@ pub fn shade<'a, W: Copy>(
                 ns: n,
                 facet: None,
                 material: None,
+                front: true,
                 lambda,
             }
         }
@@ -177,7 +183,16 @@ impl World {
         let (bxdf, frame, inside) = match ctx.material {
             Some(m) => {
                 let bxdf = self.materials.get(m as usize)?.as_ref()?;
-                let base = Frame::from_normal(ctx.ns);
+                // A reflecting model is symmetric: its frame faces the viewer. An interface that
+                // transmits has an outside and an inside (its `eta` is inside over outside), so its
+                // frame keeps the surface's own orientation and `wo` lies below it when the path
+                // arrives from within the stone.
+                let n = if ctx.front || !bxdf.flags().is_transmission() {
+                    ctx.ns
+                } else {
+                    -ctx.ns
+                };
+                let base = Frame::from_normal(n);
                 let frame = match ctx.facet {
                     Some(facet) if self.facet_bump => facet_frame(&base, facet, wo),
                     _ => base,
