@@ -29,6 +29,7 @@ pub mod lambert;
 pub mod layered;
 pub mod measure;
 pub mod microfacet;
+pub mod names;
 pub mod oren_nayar;
 pub mod record;
 pub mod smooth_dielectric;

@@ -308,8 +308,8 @@ fn summary(lib: &MaterialLibrary, args: &BrdfArgs, out: &mut impl Write) -> Resu
     )?;
     writeln!(
         out,
-        "{:<24} {:>25} {:>25} {:>25}",
-        "", "Course", "Corrected", "Reference"
+        "{:<24} {:>#25} {:>#25} {:>#25}",
+        "", models[0], models[1], models[2]
     )?;
     writeln!(
         out,

@@ -9,7 +9,7 @@ use crate::sampler::{Rng, hash_words};
 use crate::scene::stage::{Environment, LightShape, Projection, Shape};
 use crate::scene::{Effect, Scene};
 use crate::texture::{MapNode, NodeId};
-use anyhow::{Result, anyhow};
+use anyhow::Result;
 use clap::Args;
 use glam::Vec3;
 use std::fmt::Write as _;
@@ -30,12 +30,8 @@ pub struct InfoArgs {
 
 /// Runs `lapidary info`.
 pub fn run(args: &InfoArgs) -> Result<()> {
-    let recipe = GemRecipe::load(&args.recipe).map_err(|e| anyhow!("{e}"))?;
-    let mut scene = recipe.compile().map_err(|e| anyhow!("{e}"))?;
-    args.knobs
-        .apply(&mut scene)
-        .map_err(|e| anyhow!("{}: {e}", args.recipe.display()))?;
-    out!("{}", describe(&recipe, &scene, args.points));
+    let loaded = super::load::load_scene(&args.recipe, &args.knobs.accuracy(), None)?;
+    out!("{}", describe(&loaded.recipe, &loaded.scene, args.points));
     Ok(())
 }
 
@@ -132,10 +128,7 @@ pub fn describe(recipe: &GemRecipe, scene: &Scene, points: u32) -> String {
             o,
             "  {i:>3}  {name:<width$}  {:>6.2}%  {:<10}  {coats:<28}  {base}{own}{}",
             100.0 * f64::from(counts[i]) / f64::from(points),
-            format!("{:?}", s.stacks[i].model)
-                .chars()
-                .take(10)
-                .collect::<String>(),
+            format!("{:#}", s.stacks[i].model),
             if s.used[i] { "" } else { "  (unused)" }
         );
     }

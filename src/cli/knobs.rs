@@ -1,62 +1,63 @@
-//! The accuracy knobs on the command line (shared by `render` and `tradeoff`): `--model`,
-//! `--fresnel`, `--t-term`, `--absorption`, `--bump` and `--effect NAME=on|off`. They override the
-//! recipe's `render.accuracy` and every material's own choice ([`crate::scene::accuracy`]).
+//! The accuracy knobs on the command line (shared by `render`, `info` and `tradeoff`): `--model`,
+//! `--fresnel`, `--effect NAME=on|off` and the aliases `--t-term`, `--absorption` and `--bump`.
+//! [`KnobArgs::accuracy`] turns them, once, into the one knob type, an [`Accuracy`]; the loading
+//! path ([`super::load`]) applies it to the compiled scene with [`crate::scene::Scene::set_accuracy`],
+//! over the recipe's `render.accuracy` and every material's own choice
+//! ([`crate::scene::accuracy`] says which stage resolves what).
 
 use crate::bsdf::{FresnelMode, Model};
 use crate::scene::accuracy::{effect_named, parse_fresnel, parse_model, parse_switch};
-use crate::scene::{Accuracy, Effect, KnobError, Scene};
+use crate::scene::{Accuracy, Effect};
 use clap::Args;
 
-/// Accuracy knobs.
+/// Accuracy knobs as written on the command line. Only [`KnobArgs::accuracy`] reads them.
+///
+/// `--t-term V`, `--absorption V` and `--bump V` are aliases: each makes the same entry as
+/// `--effect t-term=V`, `--effect absorption=V` and `--effect facet-bump=V`. When an effect is
+/// given both ways, the `--effect` form wins.
 #[derive(Debug, Clone, Default, Args)]
 pub struct KnobArgs {
     /// Evaluation model of every material: course, corrected or reference.
     #[arg(long, value_parser = model_arg)]
-    pub model: Option<Model>,
+    model: Option<Model>,
     /// Fresnel evaluation of every material: exact, schlick, lazanyi or table.
     #[arg(long, value_parser = fresnel_arg)]
-    pub fresnel: Option<FresnelMode>,
-    /// The course's `t` term for every coated material: on or off.
-    #[arg(long, value_parser = switch_arg)]
-    pub t_term: Option<bool>,
-    /// Coat absorption: on or off.
-    #[arg(long, value_parser = switch_arg)]
-    pub absorption: Option<bool>,
-    /// Crystal-facet bump: on or off.
-    #[arg(long, value_parser = switch_arg)]
-    pub bump: Option<bool>,
+    fresnel: Option<FresnelMode>,
+    /// The course's `t` term for every coated material: on or off (same as
+    /// `--effect t-term=…`).
+    #[arg(long, value_parser = |s: &str| alias_arg(Effect::TTerm, s))]
+    t_term: Option<(Effect, bool)>,
+    /// Coat absorption: on or off (same as `--effect absorption=…`).
+    #[arg(long, value_parser = |s: &str| alias_arg(Effect::Absorption, s))]
+    absorption: Option<(Effect, bool)>,
+    /// Crystal-facet bump: on or off (same as `--effect facet-bump=…`).
+    #[arg(long, value_parser = |s: &str| alias_arg(Effect::FacetBump, s))]
+    bump: Option<(Effect, bool)>,
     /// Force any effect's code on or off, e.g. `--effect depth-of-field=off` (repeatable;
     /// `lapidary info` lists the effects).
     #[arg(long = "effect", value_parser = effect_arg)]
-    pub effects: Vec<(Effect, bool)>,
+    effects: Vec<(Effect, bool)>,
 }
 
 impl KnobArgs {
-    /// The knobs given, as an [`Accuracy`].
+    /// The knobs given, as the one knob type: the model and Fresnel mode, then the forced
+    /// effects (the aliases first, then every `--effect` in order; a later entry for an effect
+    /// replaces an earlier one).
     pub fn accuracy(&self) -> Accuracy {
         let mut acc = Accuracy {
             model: self.model,
             fresnel: self.fresnel,
             effects: vec![],
         };
-        for (e, on) in [
-            (Effect::TTerm, self.t_term),
-            (Effect::Absorption, self.absorption),
-            (Effect::FacetBump, self.bump),
-        ] {
-            if let Some(on) = on {
-                acc.force(e, on);
-            }
-        }
-        for &(e, on) in &self.effects {
+        let aliases = [self.t_term, self.absorption, self.bump];
+        for (e, on) in aliases
+            .into_iter()
+            .flatten()
+            .chain(self.effects.iter().copied())
+        {
             acc.force(e, on);
         }
         acc
-    }
-
-    /// Applies the knobs to `scene` (credited to the command line).
-    pub fn apply(&self, scene: &mut Scene) -> Result<(), KnobError> {
-        scene.set_accuracy(&self.accuracy(), "command line")
     }
 }
 
@@ -70,6 +71,11 @@ fn fresnel_arg(s: &str) -> Result<FresnelMode, String> {
 
 fn switch_arg(s: &str) -> Result<bool, String> {
     parse_switch("value", s).map_err(|e| e.0)
+}
+
+/// The value of an alias flag (`--bump off`) as the entry `--effect` makes.
+fn alias_arg(effect: Effect, s: &str) -> Result<(Effect, bool), String> {
+    Ok((effect, switch_arg(s)?))
 }
 
 fn effect_arg(s: &str) -> Result<(Effect, bool), String> {
@@ -137,7 +143,7 @@ mod tests {
     fn arguments_become_knobs() {
         let k = KnobArgs {
             model: Some(Model::Course),
-            bump: Some(false),
+            bump: Some(alias_arg(Effect::FacetBump, "off").unwrap()),
             effects: vec![effect_arg("depth-of-field=on").unwrap()],
             ..KnobArgs::default()
         };
@@ -152,6 +158,34 @@ mod tests {
                 .contains("NAME=on|off")
         );
         assert!(switch_arg("maybe").unwrap_err().contains("on, off"));
+    }
+
+    #[test]
+    fn aliases_make_the_entries_of_effect() {
+        use clap::Parser;
+        #[derive(Parser)]
+        struct Cli {
+            #[command(flatten)]
+            knobs: KnobArgs,
+        }
+        let parse = |args: &[&str]| {
+            let argv = std::iter::once("lapidary").chain(args.iter().copied());
+            Cli::try_parse_from(argv).unwrap().knobs.accuracy()
+        };
+        for (alias, effect) in [
+            (["--bump", "off"], "facet-bump=off"),
+            (["--t-term", "on"], "t-term=on"),
+            (["--absorption", "off"], "absorption=off"),
+        ] {
+            assert_eq!(parse(&alias), parse(&["--effect", effect]), "{alias:?}");
+        }
+        // Both ways: `--effect` wins, whatever the order.
+        let both = parse(&["--effect", "facet-bump=on", "--bump", "off"]);
+        assert_eq!(both.forced(Effect::FacetBump), Some(true));
+        assert_eq!(both.effects.len(), 1);
+        let acc = parse(&["--model", "Reference", "--fresnel", "table"]);
+        assert_eq!(acc.to_string(), "model=reference,fresnel=table");
+        assert!(Cli::try_parse_from(["lapidary", "--model", "fast"]).is_err());
     }
 
     #[test]

@@ -6,8 +6,8 @@
 
 use crate::bsdf::{Base, ConductorIor, StackDesc};
 use crate::image::outputs::{Format, OutputPlan};
-use crate::recipe::GemRecipe;
 use crate::sampler::{hash_words, to_unit_f32};
+use crate::scene::Accuracy;
 use crate::texture::MapHit;
 use anyhow::{Result, anyhow};
 use clap::Args;
@@ -156,11 +156,8 @@ pub fn run(args: &MapArgs) -> Result<()> {
     let mut plan = OutputPlan::new();
     plan.input(&args.recipe, "the recipe")?;
     let out_file = plan.output(&args.out, Format::Png)?;
-    let recipe = GemRecipe::load(&args.recipe).map_err(|e| anyhow!("{e}"))?;
-    for (path, role) in super::render::recipe_inputs(&recipe) {
-        plan.input(&path, role)?;
-    }
-    let surface = recipe.compile().map_err(|e| anyhow!("{e}"))?.surface;
+    let loaded = super::load::load_scene(&args.recipe, &Accuracy::default(), Some(&mut plan))?;
+    let surface = loaded.scene.surface;
     for name in surface.unused() {
         eprintln!("warning: material \"{name}\" is never used by the surface map");
     }
@@ -238,7 +235,7 @@ pub fn run(args: &MapArgs) -> Result<()> {
     writeln!(
         out,
         "{}: {} materials, plane {:?}={}, extent ±{}, {}×{} px → {}",
-        recipe.file(),
+        loaded.recipe.file(),
         mats,
         ["x", "y", "z"][args.plane.axis],
         args.plane.offset,

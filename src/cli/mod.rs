@@ -23,6 +23,7 @@ pub mod check;
 pub mod compare;
 pub mod info;
 pub mod knobs;
+pub mod load;
 pub mod map;
 pub mod plot;
 pub mod regress;

@@ -31,9 +31,8 @@ const COLOURS: [RGBColor; 3] = [
 
 fn model_label(m: Model) -> String {
     match m {
-        Model::Course => "Course".into(),
-        Model::Corrected => "Corrected".into(),
-        Model::Reference(p) => format!("Reference ({} walks)", p.samples),
+        Model::Reference(p) => format!("{m:#} ({} walks)", p.samples),
+        _ => format!("{m:#}"),
     }
 }
 

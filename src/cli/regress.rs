@@ -9,9 +9,10 @@
 use crate::image::compare::{Comparison, Options, compare_with};
 use crate::image::write_heatmap;
 use crate::image::{ExrImage, read_exr, write_exr};
-use crate::recipe::GemRecipe;
-use crate::render::{Control, Metadata, World, exr_image, render_scene};
+use crate::render::world::Setup;
+use crate::render::{Control, Metadata, exr_image, render_scene};
 use crate::sampler::SamplerKind;
+use crate::scene::Accuracy;
 use anyhow::{Result, anyhow, bail};
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -73,9 +74,8 @@ fn render_recipe(
     sampler: SamplerKind,
     threads: Option<u32>,
 ) -> Result<ExrImage> {
-    let gem = GemRecipe::load(recipe).map_err(|e| anyhow!("{e}"))?;
-    let mut scene = gem.compile().map_err(|e| anyhow!("{e}"))?;
-    let r = &mut scene.stage.render;
+    let mut loaded = super::load::load_scene(recipe, &Accuracy::default(), None)?;
+    let r = &mut loaded.scene.stage.render;
     if let Some((w, h)) = size {
         r.width = w;
         r.height = h;
@@ -83,15 +83,16 @@ fn render_recipe(
     r.spp = spp;
     r.seed = seed;
     r.sampler = sampler;
-    let world = World::new(&scene).map_err(|e| anyhow!("{}: {e}", recipe.display()))?;
+    let world = loaded.world(&Setup::default())?;
+    let scene = &loaded.scene;
     let control = Control {
         threads: threads.map(|t| t as usize),
         ..Control::default()
     };
-    let rendered = render_scene(&world, &scene, &control);
+    let rendered = render_scene(&world, scene, &control);
     Ok(exr_image(
         &rendered,
-        &Metadata::of(&recipe.display().to_string(), &scene),
+        &Metadata::of(&recipe.display().to_string(), scene),
     ))
 }
 

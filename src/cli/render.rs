@@ -8,9 +8,7 @@
 use crate::image::atomic::{abort_process, all_or_nothing};
 use crate::image::outputs::{Format, OutputPlan};
 use crate::image::{Curve, ToneMap, write_exr, write_png};
-use crate::recipe::GemRecipe;
-use crate::recipe::stage::{EnvironmentDesc, ShapeDesc};
-use crate::render::{Control, Metadata, Rendered, Strategy, World, exr_image, render_scene};
+use crate::render::{Control, Metadata, Rendered, Strategy, exr_image, render_scene};
 use crate::scene::stage::SamplerKind;
 use crate::scene::{Effect, Scene};
 use anyhow::{Context, Result, anyhow, bail};
@@ -160,28 +158,6 @@ pub(crate) fn interrupted() -> &'static AtomicBool {
     })
 }
 
-/// The files a loaded recipe reads besides itself: included libraries, the mesh, the
-/// environment map (so that none of them can be an output).
-pub(crate) fn recipe_inputs(recipe: &GemRecipe) -> Vec<(PathBuf, &'static str)> {
-    let mut inputs: Vec<(PathBuf, &'static str)> = recipe
-        .library
-        .sources()
-        .iter()
-        .skip(1)
-        .map(|s| (PathBuf::from(&s.file), "the included library"))
-        .collect();
-    let base = recipe.base_dir();
-    if let Some(stage) = &recipe.content.stage {
-        if let Some(ShapeDesc::Mesh { file, .. }) = &stage.shape {
-            inputs.push((base.join(file), "the mesh"));
-        }
-        if let Some(EnvironmentDesc::Map { file, .. }) = &stage.environment {
-            inputs.push((base.join(file), "the environment map"));
-        }
-    }
-    inputs
-}
-
 /// Where the EXR and PNG go.
 fn outputs(args: &RenderArgs) -> Result<(PathBuf, Option<PathBuf>)> {
     let exr = match &args.output {
@@ -247,15 +223,9 @@ pub fn run(args: &RenderArgs) -> Result<bool> {
         Some(p) => Some(plan.output(p, Format::Png)?),
         None => None,
     };
-    let recipe = GemRecipe::load(&args.recipe).map_err(|e| anyhow!("{e}"))?;
-    for (path, role) in recipe_inputs(&recipe) {
-        plan.input(&path, role)?;
-    }
-    let mut scene = recipe.compile().map_err(|e| anyhow!("{e}"))?;
+    let loaded = super::load::load_scene(&args.recipe, &args.knobs.accuracy(), Some(&mut plan))?;
+    let mut scene = loaded.scene;
     settings(args, &mut scene);
-    args.knobs
-        .apply(&mut scene)
-        .map_err(|e| anyhow!("{}: {e}", args.recipe.display()))?;
     let limit = args
         .max_memory
         .unwrap_or_else(crate::render::memory::default_limit);
@@ -271,13 +241,13 @@ pub fn run(args: &RenderArgs) -> Result<bool> {
         cancel: Some(cancel),
         progress: !args.quiet,
     };
-    let world = match World::build(&scene, &setup) {
+    let world = match super::load::build_world(&args.recipe, &scene, &setup) {
         Ok(w) => w,
-        Err(e @ crate::render::WorldError::Stopped) if cancel.load(Ordering::SeqCst) => {
-            eprintln!("{}: {e} (Ctrl-C or SIGTERM)", args.recipe.display());
+        Err(e) if e.stopped() && cancel.load(Ordering::SeqCst) => {
+            eprintln!("{e} (Ctrl-C or SIGTERM)");
             return Ok(true);
         }
-        Err(e) => bail!("{}: {e}", args.recipe.display()),
+        Err(e) => return Err(e.into()),
     };
     for w in world.environment.warnings() {
         eprintln!("warning: {}: {w}", args.recipe.display());

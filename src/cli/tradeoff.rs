@@ -14,13 +14,14 @@ use self::csv::{curves_csv, summary_csv, write_csv};
 pub use self::row::Row;
 use self::row::at_spp;
 use super::knobs::KnobArgs;
+use super::load::build_world;
 use super::render::parse_size;
 use crate::image::atomic::all_or_nothing;
 use crate::image::outputs::{Format, OutputPlan};
 use crate::image::{read_exr, write_exr};
-use crate::recipe::GemRecipe;
 use crate::render::study::{Convergence, Errors, Reference, converge};
-use crate::render::{Control, Metadata, World, exr_image, render_scene};
+use crate::render::world::Setup;
+use crate::render::{Control, Metadata, exr_image, render_scene};
 use crate::sampler::{SamplerKind, hash_words};
 use crate::scene::{Knobs, Scene};
 use anyhow::{Context, Result, anyhow};
@@ -140,18 +141,12 @@ pub fn run(args: &TradeoffArgs) -> Result<()> {
     let mut plan = OutputPlan::new();
     plan.input(&args.recipe, "the recipe")?;
     plan.folder(&args.out)?;
-    let recipe = GemRecipe::load(&args.recipe).map_err(|e| anyhow!("{e}"))?;
-    for (path, role) in super::render::recipe_inputs(&recipe) {
-        plan.input(&path, role)?;
-    }
-    let mut base = recipe.compile().map_err(|e| anyhow!("{e}"))?;
+    let mut base =
+        super::load::load_scene(&args.recipe, &args.knobs.accuracy(), Some(&mut plan))?.scene;
     let (w, h) = args.size;
     base.stage.render.width = w;
     base.stage.render.height = h;
     base.stage.render.seed = args.seed;
-    args.knobs
-        .apply(&mut base)
-        .map_err(|e| anyhow!("{}: {e}", args.recipe.display()))?;
     // Check every setting before the long renders.
     for (k, l) in settings.iter().zip(&labels) {
         k.apply(&mut base.clone(), "tradeoff")
@@ -176,7 +171,7 @@ pub fn run(args: &TradeoffArgs) -> Result<()> {
     // Warm up (thread pool, caches, clock frequency) on the baseline, so the first setting is not
     // timed cold: unwarmed, it ran about 10 % slower than the same work later in the run.
     {
-        let world = World::new(&base).map_err(|e| anyhow!("{}: {e}", args.recipe.display()))?;
+        let world = build_world(&args.recipe, &base, &Setup::default())?;
         converge(
             &world,
             &base,
@@ -196,7 +191,7 @@ pub fn run(args: &TradeoffArgs) -> Result<()> {
             format!("[{}/{}] {label}", i + 1, settings.len()),
         );
         let t0 = Instant::now();
-        let world = World::new(&scene).map_err(|e| anyhow!("{}: {e}", args.recipe.display()))?;
+        let world = build_world(&args.recipe, &scene, &Setup::default())?;
         let setup = t0.elapsed().as_secs_f64();
         let conv = converge(&world, &scene, budget, 1 << 20, threads);
         spinner.finish_and_clear();
@@ -296,7 +291,7 @@ fn reference(
             r.width, r.height, r.spp, r.max_depth
         ),
     );
-    let world = World::new(&scene).map_err(|e| anyhow!("{}: {e}", args.recipe.display()))?;
+    let world = build_world(&args.recipe, &scene, &Setup::default())?;
     let control = Control {
         threads,
         ..Control::default()

@@ -3,7 +3,7 @@
 //! (`render: (accuracy: (…))`) and by `lapidary tradeoff --setting …`.
 //!
 //! A knob either rewrites what the scene asks for (the evaluation model and Fresnel mode of every
-//! material) or **forces an effect's code** on or off ([`super::Effects::force`]):
+//! material) or **forces an effect's code** on or off ([`super::Effects::forced`]):
 //!
 //! | knob | forced off | forced on |
 //! |---|---|---|
@@ -15,11 +15,36 @@
 //! | `depth-of-field` | a pinhole camera | the thin-lens path is taken (at aperture 0 it gives the pinhole ray) |
 //! | `environment-importance` | an environment map is sampled uniformly | (no code to force) |
 //!
+//! # One type, resolved into the compiled scene
+//!
+//! [`Accuracy`] is the one representation of the knobs, wherever they are written: a model, a
+//! Fresnel mode and a list of forced effects. The spellings that name one effect twice are
+//! aliases that make the same entry: `bump` is `facet-bump` ([`effect_named`]), and on the command
+//! line `--bump V`, `--t-term V` and `--absorption V` are `--effect facet-bump=V`,
+//! `--effect t-term=V` and `--effect absorption=V`. Model and Fresnel names are
+//! [`crate::bsdf::names`].
+//!
+//! [`Scene::set_accuracy`] is the only place an [`Accuracy`] is applied: it rewrites the material
+//! descriptions, recounts the effects they call for and forces effects (the only caller of
+//! [`super::Effects`]' forcing), before any BSDF table or world is built. It runs at these
+//! stages, each crediting its source for `lapidary info`:
+//!
+//! 1. **compile** — `GemRecipe::compile` applies the recipe's `stage.render.accuracy`
+//!    (credited `render.accuracy (file:line)`);
+//! 2. **load** — `crate::cli::load` applies the command line's knobs, built once into an
+//!    [`Accuracy`] by `crate::cli::knobs::KnobArgs` (credited `command line`), for every command
+//!    that loads a recipe;
+//! 3. **tradeoff** — each `--setting` is a [`Knobs`] applied to a copy of the loaded scene
+//!    ([`Knobs::apply`]: its render-level part, then [`Scene::set_accuracy`]).
+//!
+//! A later stage overrides an earlier one knob by knob; `Scene::accuracy` holds the result, which
+//! the render metadata (`lapidary.accuracy`) and the summaries print.
+//!
 //! Render-level knobs (spp, sampler, maximum depth) live in the render settings; [`Knobs`] bundles
 //! them with an [`Accuracy`] for `tradeoff` settings written as `key=value,key=value`.
 
 use super::{Effect, Scene};
-use crate::bsdf::{FresnelMode, Model, ReferenceParams, StackDesc};
+use crate::bsdf::{FresnelMode, Model, StackDesc};
 use crate::sampler::SamplerKind;
 use std::fmt;
 
@@ -121,29 +146,19 @@ pub fn effect_named(key: &str) -> Option<Effect> {
     }
 }
 
-/// `course`, `corrected` or `reference` (4 walks per evaluation, depth 256).
+/// `course`, `corrected` or `reference` (4 walks per evaluation, depth 256), in any letter case
+/// ([`Model`]'s `FromStr`).
 pub fn parse_model(value: &str) -> Result<Model, KnobError> {
-    match value.to_ascii_lowercase().as_str() {
-        "course" => Ok(Model::Course),
-        "corrected" => Ok(Model::Corrected),
-        "reference" => Ok(Model::Reference(ReferenceParams::default())),
-        _ => Err(KnobError(format!(
-            "model `{value}` is not one of: course, corrected, reference"
-        ))),
-    }
+    value
+        .parse()
+        .map_err(|e: crate::bsdf::names::UnknownName| KnobError(e.to_string()))
 }
 
-/// `exact`, `schlick`, `lazanyi` or `table`.
+/// `exact`, `schlick`, `lazanyi` or `table`, in any letter case ([`FresnelMode`]'s `FromStr`).
 pub fn parse_fresnel(value: &str) -> Result<FresnelMode, KnobError> {
-    match value.to_ascii_lowercase().as_str() {
-        "exact" => Ok(FresnelMode::Exact),
-        "schlick" => Ok(FresnelMode::Schlick),
-        "lazanyi" => Ok(FresnelMode::Lazanyi),
-        "table" => Ok(FresnelMode::Table),
-        _ => Err(KnobError(format!(
-            "fresnel `{value}` is not one of: exact, schlick, lazanyi, table"
-        ))),
-    }
+    value
+        .parse()
+        .map_err(|e: crate::bsdf::names::UnknownName| KnobError(e.to_string()))
 }
 
 /// `on`/`off` (also `true`/`false`, `yes`/`no`) for knob `key`.
@@ -155,27 +170,15 @@ pub fn parse_switch(key: &str, value: &str) -> Result<bool, KnobError> {
     }
 }
 
-/// The label of a model, as the knob parser spells it.
-pub fn model_label(m: Model) -> &'static str {
-    match m {
-        Model::Course => "course",
-        Model::Corrected => "corrected",
-        Model::Reference(_) => "reference",
-    }
-}
-
 impl fmt::Display for Accuracy {
     /// `key=value` pairs joined by commas, in the form [`Accuracy::set`] reads.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let mut parts = vec![];
         if let Some(m) = self.model {
-            parts.push(format!("model={}", model_label(m)));
+            parts.push(format!("model={m}"));
         }
         if let Some(fr) = self.fresnel {
-            parts.push(format!(
-                "fresnel={}",
-                format!("{fr:?}").to_ascii_lowercase()
-            ));
+            parts.push(format!("fresnel={fr}"));
         }
         for (e, on) in &self.effects {
             let name = if *e == Effect::FacetBump {
@@ -275,7 +278,7 @@ impl fmt::Display for Knobs {
             parts.push(acc);
         }
         if let Some(s) = self.sampler {
-            parts.push(format!("sampler={}", format!("{s:?}").to_ascii_lowercase()));
+            parts.push(format!("sampler={}", s.name()));
         }
         if let Some(d) = self.max_depth {
             parts.push(format!("max-depth={d}"));
@@ -336,7 +339,7 @@ impl Scene {
                 self.effects.turn_on(
                     Effect::TTerm,
                     format!(
-                        "material \"{name}\" ({:?} model, knobs from {by})",
+                        "material \"{name}\" ({:#} model, knobs from {by})",
                         stack.model
                     ),
                 );

@@ -138,8 +138,9 @@ impl Effects {
         self.bits & effect.bit() != 0
     }
 
-    /// Forces `effect`'s code on or off; `by` names who did (a flag or a recipe field).
-    pub fn force(&mut self, effect: Effect, on: bool, by: impl Into<String>) {
+    /// Forces `effect`'s code on or off; `by` names who did (a flag or a recipe field). Only
+    /// [`super::Scene::set_accuracy`] calls it: knobs reach a scene as an [`super::Accuracy`].
+    pub(super) fn force(&mut self, effect: Effect, on: bool, by: impl Into<String>) {
         self.forced.retain(|(e, _, _)| *e != effect);
         self.forced.push((effect, on, by.into()));
     }
