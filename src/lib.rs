@@ -13,11 +13,11 @@
 //!
 //! ```
 //! use lapidary::bsdf::{Base, Bxdf, Coat, LayeredBsdf, StackDesc};
-//! use lapidary::spectrum::RgbSample;
+//! use lapidary::color::Rgb;
 //! use glam::Vec3;
 //!
-//! let coat = Coat { ior: 1.5, roughness: 5.0, absorption: RgbSample::ZERO, thickness: 0.0 };
-//! let stack = LayeredBsdf::new(&StackDesc::new(vec![coat], Base::Lambert { albedo: RgbSample::ONE }))?;
+//! let coat = Coat { ior: 1.5, roughness: 5.0, absorption: Rgb::ZERO, thickness: 0.0 };
+//! let stack = LayeredBsdf::new(&StackDesc::new(vec![coat], Base::Lambert { albedo: Rgb::ONE }))?;
 //! let wo = Vec3::new(0.3, 0.0, 0.954).normalize();
 //! let f = stack.eval(wo, Vec3::Z);
 //! assert!(f.is_valid() && f[0] > 0.0);

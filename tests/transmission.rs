@@ -10,9 +10,9 @@
 //! - smooth glass (η = 1.5) and diamond (η = 2.42): each escaping path has radiance 1 up to
 //!   rounding; only paths still trapped by total internal reflection at the depth limit lose
 //!   energy, so the mean over 20 000 paths is within 1 % below 1 and never above it;
-//! - rough glass (Walter et al. 2007, m = 20°): single-scattering micro-facets lose some energy
-//!   at every event, so the mean lies below 1 but above 0.8 (measured ≈ 0.93), and no sample
-//!   exceeds what its throughput allows. Estimates are deterministic (fixed seeds).
+//! - rough glass (Walter et al. 2007): single-scattering micro-facets lose some energy at every
+//!   event, so the mean lies below 1 (at m 5° within 2 %, at m 20° above 0.8; measured 0.992 and
+//!   0.852). Estimates are deterministic (fixed seeds).
 
 use glam::Vec3;
 use lapidary::bsdf::{
@@ -27,8 +27,6 @@ use lapidary::spectrum::RgbSample;
 const FURNACE: &str = include_str!("scenes/furnace.ron");
 /// Paths per configuration.
 const PATHS: u32 = 20_000;
-/// RMS slope angle of the rough glass, degrees.
-const ROUGH_M: f32 = 40.0;
 
 fn furnace_world(bsdf: Bsdf) -> World {
     let scene = GemRecipe::parse("furnace.ron", FURNACE)
@@ -118,19 +116,27 @@ fn smooth_dielectric_spheres_conserve_energy() {
 
 #[test]
 fn rough_dielectric_sphere_loses_a_little_and_never_gains() {
-    let glass = RoughDielectric::new(MicrofacetDistribution::new(Distribution::Blinn, ROUGH_M), 1.5);
-    let world = furnace_world(Bsdf::Dielectric(glass));
-    let samples = paths(&world, 64, Strategy::Mis);
-    let m = mean(&samples);
-    let sd = (samples
-        .iter()
-        .map(|p| (f64::from(p.radiance.luminance()) - m).powi(2))
-        .sum::<f64>()
-        / f64::from(PATHS - 1))
-    .sqrt()
-        / f64::from(PATHS).sqrt();
-    println!("rough η 1.5 m 20°: mean {m:.4} ± {sd:.4}");
-    // 4σ upper bound on 1: a lossy interface must not exceed it (two-sided 4σ ≈ 6e-5 per test).
-    assert!(m < 1.0 + 4.0 * sd, "mean {m} ± {sd}");
-    assert!(m > 0.8, "mean {m}: transmission is being dropped");
+    // (RMS slope angle in degrees, lower bound on the mean). Measured means (20 000 paths):
+    // m 5° 0.992, 10° 0.964, 20° 0.852, 40° 0.533 — single-scattering micro-facets lose more
+    // per event as they roughen, and a path inside the sphere meets the interface many times.
+    for (m, floor) in [(5.0f32, 0.98), (20.0, 0.8)] {
+        let glass = RoughDielectric::new(MicrofacetDistribution::new(Distribution::Blinn, m), 1.5);
+        let world = furnace_world(Bsdf::Dielectric(glass));
+        let samples = paths(&world, 64, Strategy::Mis);
+        let mean = mean(&samples);
+        let sd = (samples
+            .iter()
+            .map(|p| (f64::from(p.radiance.luminance()) - mean).powi(2))
+            .sum::<f64>()
+            / f64::from(PATHS - 1))
+        .sqrt()
+            / f64::from(PATHS).sqrt();
+        println!("rough η 1.5 m {m}°: mean {mean:.4} ± {sd:.4}");
+        // 4σ above 1: a lossless-at-best interface must not exceed it (one-sided 4σ ≈ 3e-5).
+        assert!(mean < 1.0 + 4.0 * sd, "m {m}: mean {mean} ± {sd}");
+        assert!(
+            mean > floor,
+            "m {m}: mean {mean}: transmission is being dropped"
+        );
+    }
 }

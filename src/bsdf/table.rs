@@ -1,4 +1,9 @@
 //! 1-D tables over `cos θ ∈ [0, 1]`, built once per material and linearly interpolated.
+//!
+//! Entries hold one value per colour channel of the RGB variant. They are not colour-independent:
+//! the stack's colour enters its integrals non-linearly (absorption inside, albedo coupled with
+//! internal reflection), so a spectral variant tabulates per wavelength bin instead
+//! (docs/design.md §12).
 
 use crate::sampler::{Rng, hash_words};
 use crate::spectrum::RgbSample;
