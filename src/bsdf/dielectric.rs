@@ -138,7 +138,12 @@ impl RoughDielectric {
         if d == 0.0 {
             return 0.0;
         }
-        let f = fresnel::dielectric(wo.dot(h), self.eta);
+        // F is the same seen from both sides of a refraction, but from the dense side near the
+        // critical angle `1 − F` is ill-conditioned in the f32 cosine (up to a rounding turning a
+        // transmission into total internal reflection): evaluate it at the direction on the rarer
+        // side, so that f(wo, wi) and f(wi, wo) agree (tests/dielectric.rs, reciprocity).
+        let rarer_is_wo = is_reflect || (wo.z > 0.0) == (self.eta >= 1.0);
+        let f = fresnel::dielectric(if rarer_is_wo { wo } else { wi }.dot(h), self.eta);
         let g = v_cavity_g(wo, wi, h);
         let v = if is_reflect {
             f * d * g / (4.0 * (wo.z * wi.z).abs())
