@@ -123,11 +123,7 @@ pub fn shade<'a, W: Copy>(
         Hit::Stone(h) => {
             // Meshes may be open or wound inconsistently: face the normals toward the viewer.
             let front = wo.dot(h.ng) >= 0.0;
-            let (ng, ns) = if !front {
-                (-h.ng, -h.ns)
-            } else {
-                (h.ng, h.ns)
-            };
+            let (ng, ns) = if !front { (-h.ng, -h.ns) } else { (h.ng, h.ns) };
             let ns = if wo.dot(ns) > 0.0 { ns } else { ng };
             let look = world.map.lookup(h.p_object, u_switch);
             t_hit = h.t;
