@@ -18,7 +18,7 @@
 //! per level, at most 6 levels): every bin gets at least 8 × 8 cells, peaks as many as they need.
 //!
 //! Significance: 0.01 for the whole suite, split over its `K` tests by Šidák's correction,
-//! `α_i = 1 − (1 − 0.01)^(1/K)` (K = 154 today: 56 component, 88 stack and 10 distribution
+//! `α_i = 1 − (1 − 0.01)^(1/K)` (K = 211 today: 108 component, 88 stack and 15 distribution
 //! configurations, so `α_i ≈ 6.5e-5`). A correct implementation then fails a run with probability
 //! 0.01. Default runs draw 200 000 samples per configuration; the full runs behind `#[ignore]`
 //! draw 2 000 000: `cargo test --release --test chi_square -- --ignored --nocapture`.
@@ -318,7 +318,7 @@ fn suite_size_matches_the_configurations() {
         subjects::stack_count(),
         subjects::CATALOGUE_SIZE * 2 * subjects::WO_DEG.len()
     );
-    assert_eq!(suite_size(), 154);
+    assert_eq!(suite_size(), 211);
 }
 
 // ------------------------------------------------------------------------------------------------

@@ -735,7 +735,11 @@ fn edge_stacks() -> Vec<StackDesc> {
         .map(|(i, (coats, base))| {
             let mut d = StackDesc::new(coats, base);
             d.fresnel = FRESNEL_MODES[i % 4];
-            d.distribution = [Distribution::Blinn, Distribution::Beckmann][(i / 4) % 2];
+            d.distribution = [
+                Distribution::Blinn,
+                Distribution::Beckmann,
+                Distribution::Ggx,
+            ][(i / 4) % 3];
             d.t_term = [None, Some(true), Some(false)][i % 3];
             d.compensation = (i / 2) % 2 == 0;
             d
@@ -964,7 +968,11 @@ fn microfacet_sampler_edges() {
     let ms = [0.01f32, 0.1, 1.0, 10.0, 45.0, 60.0, 80.0, 89.0, 89.99];
     let mut cases = Vec::new();
     for &m in &ms {
-        for dist in [Distribution::Blinn, Distribution::Beckmann] {
+        for dist in [
+            Distribution::Blinn,
+            Distribution::Beckmann,
+            Distribution::Ggx,
+        ] {
             cases.push((dist, m));
         }
     }
@@ -1042,7 +1050,11 @@ fn edge_components() -> Vec<Component> {
     let mut k = 0usize;
     for &m in &ms {
         for &fresnel in &fresnels {
-            for distribution in [Distribution::Blinn, Distribution::Beckmann] {
+            for distribution in [
+                Distribution::Blinn,
+                Distribution::Beckmann,
+                Distribution::Ggx,
+            ] {
                 out.push(Component::Torrance {
                     distribution,
                     m,
@@ -1085,7 +1097,11 @@ fn dielectric_edges() {
     let mut cases = Vec::new();
     for &m in &[0.01f32, 1.0, 20.0, 45.0, 89.0] {
         for &eta in &[1.0001f32, 1.5, 4.0, 1.0 / 1.0001, 0.25] {
-            for dist in [Distribution::Blinn, Distribution::Beckmann] {
+            for dist in [
+                Distribution::Blinn,
+                Distribution::Beckmann,
+                Distribution::Ggx,
+            ] {
                 cases.push((dist, m, eta));
             }
         }
@@ -1235,7 +1251,11 @@ fn huge_optical_depth_underflows_to_the_top_lobe() {
             d.fresnel = FRESNEL_MODES[k % 4];
             d.compensation = false;
             d.t_term = [None, Some(true)][k % 2];
-            d.distribution = [Distribution::Blinn, Distribution::Beckmann][(k / 2) % 2];
+            d.distribution = [
+                Distribution::Blinn,
+                Distribution::Beckmann,
+                Distribution::Ggx,
+            ][(k / 2) % 3];
             k += 1;
             // The same optical depth as an absorption of 1 through 1e3 units, over another coat.
             let mut d2 = d.clone();
@@ -1473,7 +1493,11 @@ fn fresnel_mode() -> impl Strategy<Value = FresnelMode> {
 }
 
 fn distribution() -> impl Strategy<Value = Distribution> {
-    prop_oneof![Just(Distribution::Blinn), Just(Distribution::Beckmann)]
+    prop_oneof![
+        Just(Distribution::Blinn),
+        Just(Distribution::Beckmann),
+        Just(Distribution::Ggx)
+    ]
 }
 
 /// A uniform number with its edges.
@@ -1633,6 +1657,9 @@ fn stack_desc() -> impl Strategy<Value = StackDesc> {
                 model,
                 fresnel,
                 distribution,
+                // The candidate directions of these checks are the V-cavity sampler's; Smith
+                // masking has its own tests (tests/chi_square.rs, tests/dielectric.rs).
+                masking: lapidary::bsdf::Masking::VCavity,
                 t_term,
                 compensation,
             },

@@ -20,8 +20,8 @@ use glam::Vec3;
 use lapidary::bsdf::TransportMode;
 use lapidary::bsdf::measure::direction_deg;
 use lapidary::bsdf::{
-    Bxdf, Distribution, Fresnel, FresnelMode, Lambert, LayeredBsdf, Metal, MicrofacetDistribution,
-    Model, OrenNayar, ReferenceParams, RoughDielectric, TorranceSparrow,
+    Bxdf, Distribution, Fresnel, FresnelMode, Lambert, LayeredBsdf, Masking, Metal,
+    MicrofacetDistribution, Model, OrenNayar, ReferenceParams, RoughDielectric, TorranceSparrow,
 };
 use lapidary::recipe::MaterialLibrary;
 use lapidary::spectrum::RgbSample;
@@ -132,11 +132,20 @@ fn components_are_reciprocal() {
     }
     let below = Vec3::new(1.0, 1.0, -1.0);
     let (eta, imp, rad) = (1.5f32, TransportMode::Importance, TransportMode::Radiance);
-    for dist in [Distribution::Blinn, Distribution::Beckmann] {
+    let maskings = [Masking::VCavity, Masking::Smith, Masking::SmithSeparable];
+    for (dist, masking) in [
+        Distribution::Blinn,
+        Distribution::Beckmann,
+        Distribution::Ggx,
+    ]
+    .into_iter()
+    .flat_map(|d| maskings.map(|m| (d, m)))
+    {
         for m in [2.0, 10.0, 30.0] {
-            let d = MicrofacetDistribution::new(dist, m);
+            let d = MicrofacetDistribution::new(dist, m).with_masking(masking);
+            let dist = format!("{dist} {masking:?}");
             let diel = TorranceSparrow::new(d, Fresnel::dielectric(eta, FresnelMode::Exact));
-            run(format!("TS dielectric {dist:?} m={m}°"), &|a, b| {
+            run(format!("TS dielectric {dist} m={m}°"), &|a, b| {
                 sym(&|x, y| diel.eval(x, y), a, b)
             });
             for metal in [Metal::Gold, Metal::Aluminium] {
@@ -146,24 +155,24 @@ fn components_are_reciprocal() {
                     Fresnel::conductor(n.into(), k.into(), FresnelMode::Exact),
                 );
                 run(
-                    format!("TS conductor {} {dist:?} m={m}°", metal.name()),
+                    format!("TS conductor {} {dist} m={m}°", metal.name()),
                     &|a, b| sym(&|x, y| cond.eval(x, y), a, b),
                 );
             }
             let glass = RoughDielectric::new(d, eta);
             let f = |x: Vec3, y: Vec3, mode| RgbSample::splat(glass.value(x, y, mode));
             run(
-                format!("RoughDielectric refl. above {dist:?} m={m}°"),
+                format!("RoughDielectric refl. above {dist} m={m}°"),
                 &|a, b| sym(&|x, y| f(x, y, rad), a, b),
             );
             run(
-                format!("RoughDielectric refl. below {dist:?} m={m}°"),
+                format!("RoughDielectric refl. below {dist} m={m}°"),
                 &|a, b| sym(&|x, y| f(x, y, rad), a * below, b * below),
             );
             // Transmission, radiance mode, wo above (η 1), wi below (η 1.5) and the reverse:
             // f(wo, wi)/η(wo)² = f(wi, wo)/η(wi)².
             run(
-                format!("RoughDielectric trans. η² {dist:?} m={m}°"),
+                format!("RoughDielectric trans. η² {dist} m={m}°"),
                 &|a, b| {
                     let (wo, wi) = (a, b * below);
                     (f(wo, wi, rad) * (eta * eta), f(wi, wo, rad))
@@ -171,11 +180,11 @@ fn components_are_reciprocal() {
             );
             // Adjoint: f_rad(wo, wi) = f_imp(wi, wo), with wo above and with wo below.
             run(
-                format!("RoughDielectric trans. adjoint, wo above {dist:?} m={m}°"),
+                format!("RoughDielectric trans. adjoint, wo above {dist} m={m}°"),
                 &|a, b| (f(a, b * below, rad), f(b * below, a, imp)),
             );
             run(
-                format!("RoughDielectric trans. adjoint, wo below {dist:?} m={m}°"),
+                format!("RoughDielectric trans. adjoint, wo below {dist} m={m}°"),
                 &|a, b| (f(a * below, b, rad), f(b, a * below, imp)),
             );
         }

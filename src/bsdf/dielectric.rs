@@ -13,7 +13,7 @@
 use super::table::Table;
 use super::{
     BsdfSample, Bxdf, Lobe, LobeFlags, LobeKind, MicrofacetDistribution, TransportMode, fresnel,
-    microfacet::v_cavity_g, reflect, refract,
+    reflect, refract,
 };
 use crate::sampler::hash_words;
 use crate::spectrum::RgbSample;
@@ -144,7 +144,7 @@ impl RoughDielectric {
         // side, so that f(wo, wi) and f(wi, wo) agree (tests/dielectric.rs, reciprocity).
         let rarer_is_wo = is_reflect || (wo.z > 0.0) == (self.eta >= 1.0);
         let f = fresnel::dielectric(if rarer_is_wo { wo } else { wi }.dot(h), self.eta);
-        let g = v_cavity_g(wo, wi, h);
+        let g = self.distribution.g(wo, wi, h);
         let v = if is_reflect {
             f * d * g / (4.0 * (wo.z * wi.z).abs())
         } else {
@@ -167,7 +167,11 @@ impl RoughDielectric {
         let Some((h, is_reflect, etap)) = self.half(wo, wi) else {
             return 0.0;
         };
-        let r = fresnel::dielectric(wo.dot(h), self.eta);
+        // The lobe probability with the Fresnel factor `value` uses (the rarer side's cosine for
+        // a transmission pair): the sampler's own `F(wo·h)` differs from it only where `1 − F` is
+        // rounding noise near the critical angle, and this keeps pdf > 0 wherever f > 0.
+        let rarer_is_wo = is_reflect || (wo.z > 0.0) == (self.eta >= 1.0);
+        let r = fresnel::dielectric(if rarer_is_wo { wo } else { wi }.dot(h), self.eta);
         let (pr, pt) = match lobes {
             Lobes::All => (r, 1.0 - r),
             Lobes::Reflection => (r, 0.0),

@@ -27,6 +27,7 @@ pub mod dielectric;
 pub mod fresnel;
 pub mod lambert;
 pub mod layered;
+pub mod masking;
 pub mod measure;
 pub mod microfacet;
 pub mod names;
@@ -42,7 +43,7 @@ pub use lambert::Lambert;
 pub use layered::{
     Base, Coat, ConductorIor, LayeredBsdf, Model, ReferenceParams, StackDesc, StackError,
 };
-pub use microfacet::{Distribution, MicrofacetDistribution};
+pub use microfacet::{Distribution, Masking, MicrofacetDistribution};
 pub use oren_nayar::OrenNayar;
 pub use record::{BsdfSample, Lobe, LobeFlags, LobeKind, TransportMode};
 pub use smooth_dielectric::SmoothDielectric;

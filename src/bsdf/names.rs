@@ -9,11 +9,14 @@
 //! | `Model::Reference(_)` | `reference` | `Reference` |
 //! | `FresnelMode::Exact` … `Table` | `exact`, `schlick`, `lazanyi`, `table` | `Exact` … `Table` |
 //!
+//! | `Distribution::Blinn`, `Beckmann`, `Ggx` | `blinn`, `beckmann`, `ggx` | `Blinn`, `Beckmann`, `Ggx` |
+//! | `Masking::VCavity`, `Smith`, `SmithSeparable` | `v-cavity`, `smith`, `smith-separable` | `VCavity`, `Smith`, `SmithSeparable` |
+//!
 //! A name carries no [`ReferenceParams`]: `reference` parses to the default walk (4 walks per
 //! evaluation, depth 256), and the walk's own parameters are set in a recipe
 //! (`Reference(samples: …, max_depth: …)`) or by `lapidary brdf --walks`.
 
-use super::{FresnelMode, Model, ReferenceParams};
+use super::{Distribution, FresnelMode, Masking, Model, ReferenceParams};
 use std::fmt;
 use std::str::FromStr;
 
@@ -63,6 +66,95 @@ impl FresnelMode {
             FresnelMode::Lazanyi => Self::NAMES[2],
             FresnelMode::Table => Self::NAMES[3],
         }
+    }
+}
+
+impl Distribution {
+    /// Every distribution, in the order of [`Distribution::NAMES`].
+    pub const ALL: [Distribution; 3] = [
+        Distribution::Blinn,
+        Distribution::Beckmann,
+        Distribution::Ggx,
+    ];
+    /// Every distribution name.
+    pub const NAMES: [&'static str; 3] = ["blinn", "beckmann", "ggx"];
+
+    /// The knob spelling.
+    pub fn name(self) -> &'static str {
+        Self::NAMES[Self::ALL.iter().position(|d| *d == self).unwrap_or(0)]
+    }
+}
+
+impl Masking {
+    /// Every masking term, in the order of [`Masking::NAMES`].
+    pub const ALL: [Masking; 3] = [Masking::VCavity, Masking::Smith, Masking::SmithSeparable];
+    /// Every masking name.
+    pub const NAMES: [&'static str; 3] = ["v-cavity", "smith", "smith-separable"];
+    /// The recipe spellings, in the same order.
+    const RECIPE: [&'static str; 3] = ["VCavity", "Smith", "SmithSeparable"];
+
+    /// The knob spelling.
+    pub fn name(self) -> &'static str {
+        Self::NAMES[self.index()]
+    }
+
+    fn index(self) -> usize {
+        Self::ALL.iter().position(|m| *m == self).unwrap_or(0)
+    }
+}
+
+impl fmt::Display for Distribution {
+    /// `blinn`, `beckmann` or `ggx`; with `{:#}` capitalised.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write_name(f, self.name())
+    }
+}
+
+impl fmt::Display for Masking {
+    /// `v-cavity`, `smith` or `smith-separable`; with `{:#}` the recipe spelling.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if f.alternate() {
+            f.pad(Self::RECIPE[self.index()])
+        } else {
+            f.pad(self.name())
+        }
+    }
+}
+
+impl FromStr for Distribution {
+    type Err = UnknownName;
+
+    /// `blinn`, `beckmann` or `ggx` (also `trowbridge-reitz`), in any letter case.
+    fn from_str(s: &str) -> Result<Distribution, UnknownName> {
+        let lower = s.to_ascii_lowercase();
+        if lower == "trowbridge-reitz" {
+            return Ok(Distribution::Ggx);
+        }
+        Distribution::ALL
+            .into_iter()
+            .find(|d| d.name() == lower)
+            .ok_or_else(|| UnknownName {
+                what: "distribution",
+                value: s.to_string(),
+                allowed: &Distribution::NAMES,
+            })
+    }
+}
+
+impl FromStr for Masking {
+    type Err = UnknownName;
+
+    /// `v-cavity`, `smith` or `smith-separable` (or the recipe spellings), in any letter case.
+    fn from_str(s: &str) -> Result<Masking, UnknownName> {
+        let lower = s.to_ascii_lowercase();
+        Masking::ALL
+            .into_iter()
+            .find(|m| m.name() == lower || Masking::RECIPE[m.index()].to_ascii_lowercase() == lower)
+            .ok_or_else(|| UnknownName {
+                what: "masking",
+                value: s.to_string(),
+                allowed: &Masking::NAMES,
+            })
     }
 }
 
@@ -135,6 +227,23 @@ impl FromStr for FresnelMode {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn distributions_and_maskings_round_trip() {
+        for d in Distribution::ALL {
+            assert_eq!(d.to_string().parse::<Distribution>(), Ok(d));
+            assert_eq!(format!("{d:#}").parse::<Distribution>(), Ok(d));
+        }
+        for m in Masking::ALL {
+            assert_eq!(m.to_string().parse::<Masking>(), Ok(m));
+            assert_eq!(format!("{m:#}").parse::<Masking>(), Ok(m));
+        }
+        assert_eq!("GGX".parse::<Distribution>(), Ok(Distribution::Ggx));
+        let e = "phong".parse::<Distribution>().unwrap_err().to_string();
+        assert!(e.contains("blinn, beckmann, ggx"), "{e}");
+        let e = "torrance".parse::<Masking>().unwrap_err().to_string();
+        assert!(e.contains("v-cavity, smith, smith-separable"), "{e}");
+    }
 
     #[test]
     fn models_round_trip() {

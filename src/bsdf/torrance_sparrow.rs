@@ -13,7 +13,7 @@
 
 use super::table::Table;
 use super::{Bsdf, Lobe, LobeFlags, LobeKind, TransportMode, flush_tiny};
-use super::{BsdfSample, Bxdf, Fresnel, MicrofacetDistribution, microfacet::v_cavity_g, reflect};
+use super::{BsdfSample, Bxdf, Fresnel, MicrofacetDistribution, reflect};
 use crate::sampler::hash_words;
 use crate::spectrum::RgbSample;
 use glam::{Vec2, Vec3};
@@ -107,7 +107,7 @@ impl Bxdf for TorranceSparrow {
         if d == 0.0 {
             return RgbSample::ZERO;
         }
-        let g = v_cavity_g(wo, wi, h);
+        let g = self.distribution.g(wo, wi, h);
         let f = self.fresnel.eval(wi.dot(h).max(0.0));
         let v = f * (d * g / (4.0 * wo.z * wi.z));
         flush_tiny(if self.compensation.is_some() {

@@ -5,7 +5,7 @@
 //! over the recipe's `render.accuracy` and every material's own choice
 //! ([`crate::scene::accuracy`] says which stage resolves what).
 
-use crate::bsdf::{FresnelMode, Model};
+use crate::bsdf::{Distribution, FresnelMode, Masking, Model};
 use crate::scene::accuracy::{effect_named, parse_fresnel, parse_model, parse_switch};
 use crate::scene::{Accuracy, Effect};
 use clap::Args;
@@ -23,6 +23,12 @@ pub struct KnobArgs {
     /// Fresnel evaluation of every material: exact, schlick, lazanyi or table.
     #[arg(long, value_parser = fresnel_arg)]
     fresnel: Option<FresnelMode>,
+    /// Micro-facet distribution of every material: blinn, beckmann or ggx.
+    #[arg(long, value_parser = |s: &str| s.parse::<Distribution>().map_err(|e| e.to_string()))]
+    distribution: Option<Distribution>,
+    /// Masking–shadowing of every material: v-cavity, smith or smith-separable.
+    #[arg(long, value_parser = |s: &str| s.parse::<Masking>().map_err(|e| e.to_string()))]
+    masking: Option<Masking>,
     /// The course's `t` term for every coated material: on or off (same as
     /// `--effect t-term=…`).
     #[arg(long, value_parser = |s: &str| alias_arg(Effect::TTerm, s))]
@@ -47,6 +53,8 @@ impl KnobArgs {
         let mut acc = Accuracy {
             model: self.model,
             fresnel: self.fresnel,
+            distribution: self.distribution,
+            masking: self.masking,
             effects: vec![],
         };
         let aliases = [self.t_term, self.absorption, self.bump];

@@ -216,6 +216,8 @@ impl Compiler<'_> {
         let mut acc = Accuracy {
             model: desc.model.as_ref().map(|m| m.to_model()),
             fresnel: desc.fresnel,
+            distribution: desc.distribution,
+            masking: desc.masking,
             effects: vec![],
         };
         for (key, value) in [

@@ -6,14 +6,16 @@
 //!     coats: [(ior: 1.6, roughness: 12.0, thickness: 0.5)],
 //!     base: Lambert(albedo: Srgb(0.37, 0.09, 0.11)),
 //!     // optional: model: Corrected | Course | Reference(samples: 4, max_depth: 256),
-//!     //           fresnel: Exact | Schlick | Lazanyi | Table, distribution: Blinn | Beckmann,
+//!     //           fresnel: Exact | Schlick | Lazanyi | Table,
+//!     //           distribution: Blinn | Beckmann | Ggx, masking: VCavity | Smith | SmithSeparable,
 //!     //           t_term: true/false, compensation: true/false
 //! )
 //! ```
 
 use super::color::ColorDesc;
 use crate::bsdf::{
-    Base, Coat, ConductorIor, Distribution, FresnelMode, Metal, Model, ReferenceParams, StackDesc,
+    Base, Coat, ConductorIor, Distribution, FresnelMode, Masking, Metal, Model, ReferenceParams,
+    StackDesc,
 };
 use crate::color::Rgb;
 use serde::{Deserialize, Serialize};
@@ -24,8 +26,14 @@ use serde::{Deserialize, Serialize};
 pub struct CoatDesc {
     /// Absolute IOR of the varnish, 1.0001 ..= 10.
     pub ior: f32,
-    /// RMS micro-facet slope angle in degrees, 0.01 ..< 90.
-    pub roughness: f32,
+    /// RMS micro-facet slope angle in degrees, 0.01 ..< 90 (`α = tan m`). Exclusive with
+    /// `alpha`; one of them is required.
+    #[serde(default)]
+    pub roughness: Option<f32>,
+    /// Roughness as `α` (the unit of pbrt-v4 and Mitsuba 3), 0.0002 ..= 10. Exclusive with
+    /// `roughness`.
+    #[serde(default)]
+    pub alpha: Option<f32>,
     /// Layer thickness (course units, fig. 3.4 uses 0 … 15), ≥ 0. Default 0.
     #[serde(default)]
     pub thickness: f32,
@@ -84,9 +92,39 @@ pub enum BaseDesc {
     Conductor {
         /// Optical constants.
         metal: MetalDesc,
-        /// RMS slope angle in degrees, 0.01 ..< 90.
-        roughness: f32,
+        /// RMS slope angle in degrees, 0.01 ..< 90. Exclusive with `alpha`; one is required.
+        #[serde(default)]
+        roughness: Option<f32>,
+        /// Roughness as `α`, 0.0002 ..= 10. Exclusive with `roughness`.
+        #[serde(default)]
+        alpha: Option<f32>,
     },
+}
+
+/// Smallest and largest `alpha` a recipe may give.
+pub const ALPHA_RANGE: (f32, f32) = (0.0002, 10.0);
+
+/// The RMS slope angle in degrees of a roughness given as `roughness` (degrees) or `alpha`
+/// (`m = atan α`); `what` names the element in the error.
+fn slope_angle(roughness: Option<f32>, alpha: Option<f32>, what: &str) -> Result<f32, String> {
+    match (roughness, alpha) {
+        (Some(m), None) => Ok(m),
+        (None, Some(a)) => {
+            if !(ALPHA_RANGE.0..=ALPHA_RANGE.1).contains(&a) {
+                return Err(format!(
+                    "{what}.alpha = {a} is out of range: allowed {} ..= {}",
+                    ALPHA_RANGE.0, ALPHA_RANGE.1
+                ));
+            }
+            Ok((f64::from(a).atan().to_degrees()) as f32)
+        }
+        (Some(_), Some(_)) => Err(format!(
+            "{what}: give either `roughness` (degrees) or `alpha`, not both"
+        )),
+        (None, None) => Err(format!(
+            "{what}: needs a roughness: `roughness` (RMS slope angle, degrees) or `alpha`"
+        )),
+    }
 }
 
 fn coat_list<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Vec<CoatDesc>, D::Error> {
@@ -163,6 +201,9 @@ pub struct MaterialDesc {
     /// Micro-facet distribution (default Blinn).
     #[serde(default)]
     pub distribution: Distribution,
+    /// Masking–shadowing (default the course's V-cavity).
+    #[serde(default)]
+    pub masking: Masking,
     /// The course's `t` term; default: on for Course, off otherwise.
     #[serde(default)]
     pub t_term: Option<bool>,
@@ -205,7 +246,7 @@ impl MaterialDesc {
             };
             coats.push(Coat {
                 ior: c.ior,
-                roughness: c.roughness,
+                roughness: slope_angle(c.roughness, c.alpha, &format!("coats[{i}]"))?,
                 absorption,
                 thickness: c.thickness,
             });
@@ -218,7 +259,11 @@ impl MaterialDesc {
                 albedo: albedo.to_rgb().map_err(|e| format!("base.albedo: {e}"))?,
                 sigma: *sigma,
             },
-            BaseDesc::Conductor { metal, roughness } => {
+            BaseDesc::Conductor {
+                metal,
+                roughness,
+                alpha,
+            } => {
                 let preset = |m: Metal| {
                     let (n, k) = m.nk();
                     ConductorIor::Complex { n, k }
@@ -237,7 +282,7 @@ impl MaterialDesc {
                 };
                 Base::Conductor {
                     ior,
-                    roughness: *roughness,
+                    roughness: slope_angle(*roughness, *alpha, "base")?,
                 }
             }
         };
@@ -247,6 +292,7 @@ impl MaterialDesc {
             model: self.model.to_model(),
             fresnel: self.fresnel,
             distribution: self.distribution,
+            masking: self.masking,
             t_term: self.t_term,
             compensation: self.compensation,
         })

@@ -21,7 +21,7 @@
 use super::color::ColorDesc;
 use super::material::ModelDesc;
 use super::ranged::{finite, sizes_ok, whole};
-use crate::bsdf::FresnelMode;
+use crate::bsdf::{Distribution, FresnelMode, Masking};
 use indexmap::IndexMap;
 use serde::{Deserialize, Deserializer, Serialize};
 
@@ -457,6 +457,12 @@ pub struct AccuracyDesc {
     /// Fresnel evaluation for every material.
     #[serde(default)]
     pub fresnel: Option<FresnelMode>,
+    /// Micro-facet distribution for every material.
+    #[serde(default)]
+    pub distribution: Option<Distribution>,
+    /// Masking–shadowing for every material.
+    #[serde(default)]
+    pub masking: Option<Masking>,
     /// The course's `t` term on or off for every coated material.
     #[serde(default)]
     pub t_term: Option<bool>,

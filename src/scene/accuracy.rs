@@ -44,7 +44,8 @@
 //! them with an [`Accuracy`] for `tradeoff` settings written as `key=value,key=value`.
 
 use super::{Effect, Scene};
-use crate::bsdf::{FresnelMode, Model, StackDesc};
+use crate::bsdf::names::UnknownName;
+use crate::bsdf::{Distribution, FresnelMode, Masking, Model, StackDesc};
 use crate::sampler::SamplerKind;
 use std::fmt;
 
@@ -55,6 +56,10 @@ pub struct Accuracy {
     pub model: Option<Model>,
     /// Fresnel evaluation for every material (`None`: each material's own).
     pub fresnel: Option<FresnelMode>,
+    /// Micro-facet distribution for every material (`None`: each material's own).
+    pub distribution: Option<Distribution>,
+    /// Masking–shadowing for every material (`None`: each material's own).
+    pub masking: Option<Masking>,
     /// Effects forced on (`true`) or off, in the order they were set.
     pub effects: Vec<(Effect, bool)>,
 }
@@ -90,6 +95,20 @@ impl Accuracy {
         match key {
             "model" => self.model = Some(parse_model(value)?),
             "fresnel" => self.fresnel = Some(parse_fresnel(value)?),
+            "distribution" => {
+                self.distribution = Some(
+                    value
+                        .parse()
+                        .map_err(|e: UnknownName| KnobError(e.to_string()))?,
+                )
+            }
+            "masking" => {
+                self.masking = Some(
+                    value
+                        .parse()
+                        .map_err(|e: UnknownName| KnobError(e.to_string()))?,
+                )
+            }
             _ => {
                 let effect = effect_named(key).ok_or_else(|| {
                     KnobError(format!(
@@ -111,6 +130,12 @@ impl Accuracy {
         if let Some(f) = self.fresnel {
             stack.fresnel = f;
         }
+        if let Some(d) = self.distribution {
+            stack.distribution = d;
+        }
+        if let Some(m) = self.masking {
+            stack.masking = m;
+        }
         if let Some(t) = self.forced(Effect::TTerm) {
             stack.t_term = Some(t);
         }
@@ -123,9 +148,11 @@ impl Accuracy {
 }
 
 /// Every knob key [`Knobs::set`] accepts (the effect names of [`Effect::name`] work too).
-pub const KNOB_KEYS: [&str; 11] = [
+pub const KNOB_KEYS: [&str; 13] = [
     "model",
     "fresnel",
+    "distribution",
+    "masking",
     "t-term",
     "absorption",
     "bump",
@@ -179,6 +206,12 @@ impl fmt::Display for Accuracy {
         }
         if let Some(fr) = self.fresnel {
             parts.push(format!("fresnel={fr}"));
+        }
+        if let Some(d) = self.distribution {
+            parts.push(format!("distribution={d}"));
+        }
+        if let Some(m) = self.masking {
+            parts.push(format!("masking={m}"));
         }
         for (e, on) in &self.effects {
             let name = if *e == Effect::FacetBump {

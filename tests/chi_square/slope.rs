@@ -18,7 +18,11 @@ use std::f64::consts::PI;
 pub const ROUGHNESS: [f32; 5] = [0.01, 0.1, 1.0, 10.0, 45.0];
 
 /// Both distributions.
-pub const KINDS: [Distribution; 2] = [Distribution::Blinn, Distribution::Beckmann];
+pub const KINDS: [Distribution; 3] = [
+    Distribution::Blinn,
+    Distribution::Beckmann,
+    Distribution::Ggx,
+];
 
 /// Number of configurations.
 pub fn count() -> usize {

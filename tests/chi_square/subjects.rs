@@ -6,8 +6,8 @@ use lapidary::bsdf::dielectric::Lobes;
 use lapidary::bsdf::measure::direction_deg;
 use lapidary::bsdf::{
     Base, Bsdf, BsdfSample, Bxdf, Distribution, Fresnel, FresnelMode, Lambert, LayeredBsdf,
-    LobeFlags, Metal, MicrofacetDistribution, Model, OrenNayar, RoughDielectric, TorranceSparrow,
-    TransportMode,
+    LobeFlags, Masking, Metal, MicrofacetDistribution, Model, OrenNayar, RoughDielectric,
+    TorranceSparrow, TransportMode,
 };
 use lapidary::recipe::MaterialLibrary;
 use lapidary::spectrum::RgbSample;
@@ -131,6 +131,44 @@ pub fn component_bsdfs() -> Vec<(String, SharedBxdf, bool)> {
             false,
         ));
     }
+    // Smith masking (issue 16): every distribution × both Smith forms, with their own
+    // samplers (GGX visible normals, D·cos for Beckmann and Blinn), dielectric and gold Fresnel,
+    // and the smooth-ish and rough ends.
+    for (kind, m) in [
+        (Distribution::Ggx, 5.0),
+        (Distribution::Ggx, 30.0),
+        (Distribution::Beckmann, 20.0),
+        (Distribution::Blinn, 20.0),
+    ] {
+        for masking in [Masking::Smith, Masking::SmithSeparable] {
+            let dist = MicrofacetDistribution::new(kind, m).with_masking(masking);
+            v.push((
+                format!("ts dielectric eta=1.5 {kind:?} {masking:?} m={m}"),
+                shared(Bsdf::TorranceSparrow(TorranceSparrow::new(
+                    dist,
+                    diel.clone(),
+                ))),
+                false,
+            ));
+        }
+        let dist = MicrofacetDistribution::new(kind, m).with_masking(Masking::Smith);
+        v.push((
+            format!("ts gold compensated {kind:?} Smith m={m}"),
+            shared(Bsdf::TorranceSparrow(
+                TorranceSparrow::new(dist, gold.clone()).with_compensation(),
+            )),
+            false,
+        ));
+    }
+    v.push((
+        "ts dielectric eta=1.5 Ggx VCavity m=20".into(),
+        shared(Bsdf::TorranceSparrow(ts(
+            Distribution::Ggx,
+            20.0,
+            diel.clone(),
+        ))),
+        false,
+    ));
     for m in [10.0, 30.0] {
         v.push((
             format!("rough dielectric eta=1.5 blinn m={m}"),
@@ -151,8 +189,8 @@ pub fn components() -> Vec<Subject> {
 
 /// Number of component configurations, without building anything heavy.
 pub fn component_count() -> usize {
-    // 10 components above the surface only, 2 rough dielectrics on both sides.
-    10 * WO_DEG.len() + 2 * 2 * WO_DEG.len()
+    // 10 + 13 (Smith, GGX) components above the surface only, 2 rough dielectrics on both sides.
+    23 * WO_DEG.len() + 2 * 2 * WO_DEG.len()
 }
 
 /// The catalogue's stacks under Course and Corrected. With `resolvable`, every coat and conductor

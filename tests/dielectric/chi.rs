@@ -7,7 +7,7 @@ use super::checks::{SampleStats, check_rough};
 use super::common::{ChiSquare, SphereGrid, chi_square_pooled};
 use glam::Vec3;
 use lapidary::bsdf::measure::direction_deg;
-use lapidary::bsdf::{Bxdf, Distribution, MicrofacetDistribution, RoughDielectric};
+use lapidary::bsdf::{Bxdf, Distribution, Masking, MicrofacetDistribution, RoughDielectric};
 use lapidary::sampler::{Rng, hash_words};
 
 /// Histogram resolution over the sphere (3.75° bins), as in tests/chi_square.rs.
@@ -29,6 +29,13 @@ pub const SURFACES: [(Distribution, f32); 4] = [
     (Distribution::Blinn, 20.0),
     (Distribution::Blinn, 45.0),
     (Distribution::Beckmann, 20.0),
+];
+/// Surfaces with Smith masking (issue 16): GGX with its visible-normal sampler, Beckmann with
+/// `D cos` sampling; height-correlated and separable forms.
+pub const SMITH_SURFACES: [(Distribution, f32, Masking); 3] = [
+    (Distribution::Ggx, 20.0, Masking::Smith),
+    (Distribution::Ggx, 45.0, Masking::SmithSeparable),
+    (Distribution::Beckmann, 20.0, Masking::Smith),
 ];
 /// Relative IORs (below / above): glass, diamond, and glass with the dense side above.
 pub const ETAS: [f32; 3] = [1.5, 2.4, 1.0 / 1.5];
@@ -52,7 +59,11 @@ pub struct Config {
 /// Every surface × IOR × view, above and below.
 pub fn configs() -> Vec<Config> {
     let mut v = Vec::new();
-    for &(kind, m) in &SURFACES {
+    let surfaces = SURFACES
+        .iter()
+        .map(|&(k, m)| (k, m, Masking::VCavity))
+        .chain(SMITH_SURFACES);
+    for (kind, m, masking) in surfaces {
         for &eta in &ETAS {
             for &(t, p) in &VIEWS {
                 for below in [false, true] {
@@ -63,8 +74,11 @@ pub fn configs() -> Vec<Config> {
                         (w, (t, p))
                     };
                     v.push(Config {
-                        label: format!("{kind:?} m={m} eta={eta:.4}"),
-                        bsdf: RoughDielectric::new(MicrofacetDistribution::new(kind, m), eta),
+                        label: format!("{kind:?} {masking:?} m={m} eta={eta:.4}"),
+                        bsdf: RoughDielectric::new(
+                            MicrofacetDistribution::new(kind, m).with_masking(masking),
+                            eta,
+                        ),
                         wo,
                         wo_deg: deg,
                     });
@@ -76,7 +90,7 @@ pub fn configs() -> Vec<Config> {
 }
 
 /// Number of configurations of [`configs`].
-pub const COUNT: usize = SURFACES.len() * ETAS.len() * VIEWS.len() * 2;
+pub const COUNT: usize = (SURFACES.len() + SMITH_SURFACES.len()) * ETAS.len() * VIEWS.len() * 2;
 
 /// The result of one configuration.
 pub struct Row {

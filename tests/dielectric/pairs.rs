@@ -83,6 +83,11 @@ pub fn walter_f64(
             let t2 = (1.0 - c * c) / (c * c);
             (-t2 / (a * a)).exp() / (PI * a * a * c.powi(4))
         }
+        // Walter et al. 2007 eq. 33.
+        Distribution::Ggx => {
+            let t2 = (1.0 - c * c) / (c * c);
+            a * a / (PI * c.powi(4) * (a * a + t2).powi(2))
+        }
     };
     let g1 = |w: DVec3| (2.0 * h.z * w.z.abs() / w.dot(h).abs()).min(1.0);
     let g = g1(wo).min(g1(wi));

@@ -24,8 +24,7 @@
 use super::{LayeredBsdf, absorption, course};
 use crate::bsdf::table::{Table, for_strata};
 use crate::bsdf::{
-    Bsdf, BsdfSample, Bxdf, Lobe, LobeKind, microfacet::v_cavity_g, refract_macro,
-    sample_cosine_hemisphere,
+    Bsdf, BsdfSample, Bxdf, Lobe, LobeKind, refract_macro, sample_cosine_hemisphere,
 };
 use crate::sampler::hash_words;
 use crate::spectrum::RgbSample;
@@ -54,7 +53,7 @@ pub fn eval(stack: &LayeredBsdf, l: usize, wo: Vec3, wi: Vec3) -> RgbSample {
             let exit = if stack.t_term() {
                 let h = (wo + wi).normalize_or_zero();
                 let g = if h.z > 0.0 {
-                    v_cavity_g(wo, wi, h)
+                    lv.top.distribution.g(wo, wi, h)
                 } else {
                     1.0
                 };

@@ -7,7 +7,7 @@
 //! [`super::corrected`] without the multiple-reflection lobe.
 
 use super::LayeredBsdf;
-use crate::bsdf::{Bxdf, microfacet::v_cavity_g, refract_macro};
+use crate::bsdf::{Bxdf, refract_macro};
 use crate::spectrum::RgbSample;
 use glam::Vec3;
 
@@ -31,7 +31,7 @@ pub fn eval(stack: &LayeredBsdf, l: usize, wo: Vec3, wi: Vec3) -> RgbSample {
     let t = if stack.t_term() {
         let h = (wo + wi).normalize_or_zero();
         let g = if h.z > 0.0 {
-            v_cavity_g(wo, wi, h)
+            lv.top.distribution.g(wo, wi, h)
         } else {
             1.0
         };

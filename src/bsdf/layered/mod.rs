@@ -23,7 +23,7 @@ pub mod reference;
 
 use super::table::Table;
 use super::{
-    Bsdf, BsdfSample, Bxdf, Distribution, Fresnel, FresnelMode, Lambert, LobeFlags,
+    Bsdf, BsdfSample, Bxdf, Distribution, Fresnel, FresnelMode, Lambert, LobeFlags, Masking,
     MicrofacetDistribution, OrenNayar, RoughDielectric, TorranceSparrow, TransportMode,
 };
 use crate::color::Rgb;
@@ -128,6 +128,8 @@ pub struct StackDesc {
     pub fresnel: FresnelMode,
     /// Micro-facet distribution for all interfaces.
     pub distribution: Distribution,
+    /// Masking–shadowing for all interfaces.
+    pub masking: Masking,
     /// The course's internal-reflection term `t` (eq. 3.3); `None` = the model's default (on for
     /// Course, off for Corrected; the Reference has no such term).
     pub t_term: Option<bool>,
@@ -145,6 +147,7 @@ impl StackDesc {
             model: Model::default(),
             fresnel: FresnelMode::Exact,
             distribution: Distribution::Blinn,
+            masking: Masking::VCavity,
             t_term: None,
             compensation: true,
         }
@@ -259,6 +262,7 @@ pub struct LayeredBsdf {
     pub(crate) compensation: bool,
     pub(crate) fresnel: FresnelMode,
     pub(crate) distribution: Distribution,
+    pub(crate) masking: Masking,
 }
 
 /// Table entries are measured on a stratified `TABLE_GRID²` grid of directions, each with
@@ -274,7 +278,8 @@ impl LayeredBsdf {
         for c in &desc.coats {
             let eta = c.ior / above;
             above = c.ior;
-            let dist = MicrofacetDistribution::new(desc.distribution, c.roughness);
+            let dist = MicrofacetDistribution::new(desc.distribution, c.roughness)
+                .with_masking(desc.masking);
             levels.push(Level {
                 eta,
                 top: TorranceSparrow::new(dist, Fresnel::dielectric(eta, desc.fresnel)),
@@ -308,7 +313,8 @@ impl LayeredBsdf {
                     ),
                 };
                 Bsdf::TorranceSparrow(TorranceSparrow::new(
-                    MicrofacetDistribution::new(desc.distribution, roughness),
+                    MicrofacetDistribution::new(desc.distribution, roughness)
+                        .with_masking(desc.masking),
                     fresnel,
                 ))
             }
@@ -330,6 +336,7 @@ impl LayeredBsdf {
             compensation: desc.compensation,
             fresnel: desc.fresnel,
             distribution: desc.distribution,
+            masking: desc.masking,
         };
         for l in (0..stack.levels.len()).rev() {
             corrected::build_tables(&mut stack, l, TABLE_GRID);
@@ -374,9 +381,13 @@ impl LayeredBsdf {
             Model::Reference(p) => format!("Reference({} walks, depth {})", p.samples, p.max_depth),
         };
         format!(
-            "model {model}, fresnel {:?}, distribution {:?}, t term {}, compensation {}",
+            "model {model}, fresnel {:?}, distribution {:?}{}, t term {}, compensation {}",
             self.fresnel,
             self.distribution,
+            match self.masking {
+                Masking::VCavity => String::new(),
+                m => format!(", masking {m:?}"),
+            },
             if self.t_term() { "on" } else { "off" },
             if self.compensation { "on" } else { "off" }
         )
