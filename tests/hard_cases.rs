@@ -1660,6 +1660,7 @@ fn stack_desc() -> impl Strategy<Value = StackDesc> {
                 // The candidate directions of these checks are the V-cavity sampler's; Smith
                 // masking has its own tests (tests/chi_square.rs, tests/dielectric.rs).
                 masking: lapidary::bsdf::Masking::VCavity,
+                outside_ior: 1.0,
                 t_term,
                 compensation,
             },

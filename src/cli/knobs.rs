@@ -29,6 +29,9 @@ pub struct KnobArgs {
     /// Masking–shadowing of every material: v-cavity, smith or smith-separable.
     #[arg(long, value_parser = |s: &str| s.parse::<Masking>().map_err(|e| e.to_string()))]
     masking: Option<Masking>,
+    /// Multiple-scattering compensation of every material: on or off.
+    #[arg(long, value_parser = switch_arg)]
+    compensation: Option<bool>,
     /// The course's `t` term for every coated material: on or off (same as
     /// `--effect t-term=…`).
     #[arg(long, value_parser = |s: &str| alias_arg(Effect::TTerm, s))]
@@ -55,6 +58,7 @@ impl KnobArgs {
             fresnel: self.fresnel,
             distribution: self.distribution,
             masking: self.masking,
+            compensation: self.compensation,
             effects: vec![],
         };
         let aliases = [self.t_term, self.absorption, self.bump];

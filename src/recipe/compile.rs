@@ -218,6 +218,7 @@ impl Compiler<'_> {
             fresnel: desc.fresnel,
             distribution: desc.distribution,
             masking: desc.masking,
+            compensation: desc.compensation,
             effects: vec![],
         };
         for (key, value) in [

@@ -8,7 +8,7 @@
 //!     // optional: model: Corrected | Course | Reference(samples: 4, max_depth: 256),
 //!     //           fresnel: Exact | Schlick | Lazanyi | Table,
 //!     //           distribution: Blinn | Beckmann | Ggx, masking: VCavity | Smith | SmithSeparable,
-//!     //           t_term: true/false, compensation: true/false
+//!     //           outside_ior: 1.33, t_term: true/false, compensation: true/false
 //! )
 //! ```
 
@@ -59,7 +59,7 @@ pub enum MetalDesc {
     Copper,
     /// Aluminium (Rakić 1995).
     Aluminium,
-    /// Brass (Querry 1987).
+    /// Brass, 70 % Cu / 30 % Zn (Querry 1985; docs/metals.md).
     Brass,
     /// A perfect mirror (reflectance 1).
     Perfect,
@@ -179,6 +179,10 @@ impl ModelDesc {
     }
 }
 
+fn air() -> f32 {
+    1.0
+}
+
 fn yes() -> bool {
     true
 }
@@ -204,6 +208,10 @@ pub struct MaterialDesc {
     /// Masking–shadowing (default the course's V-cavity).
     #[serde(default)]
     pub masking: Masking,
+    /// Absolute IOR of the medium outside the surface (default 1, air; e.g. 1.33 under water),
+    /// 1 ..= 3.
+    #[serde(default = "air")]
+    pub outside_ior: f32,
     /// The course's `t` term; default: on for Course, off otherwise.
     #[serde(default)]
     pub t_term: Option<bool>,
@@ -293,6 +301,7 @@ impl MaterialDesc {
             fresnel: self.fresnel,
             distribution: self.distribution,
             masking: self.masking,
+            outside_ior: self.outside_ior,
             t_term: self.t_term,
             compensation: self.compensation,
         })

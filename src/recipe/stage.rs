@@ -463,6 +463,9 @@ pub struct AccuracyDesc {
     /// Masking–shadowing for every material.
     #[serde(default)]
     pub masking: Option<Masking>,
+    /// Multiple-scattering compensation on or off for every material.
+    #[serde(default)]
+    pub compensation: Option<bool>,
     /// The course's `t` term on or off for every coated material.
     #[serde(default)]
     pub t_term: Option<bool>,

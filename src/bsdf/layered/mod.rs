@@ -34,7 +34,7 @@ use serde::{Deserialize, Serialize};
 /// One coat of a stack: a rough dielectric interface and the varnish below it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Coat {
-    /// Absolute IOR of the varnish (the medium above the top coat is air, IOR 1).
+    /// Absolute IOR of the varnish (the medium above the top coat is [`StackDesc::outside_ior`]).
     pub ior: f32,
     /// RMS micro-facet slope angle of the interface, degrees (0 < m < 90).
     pub roughness: f32,
@@ -130,6 +130,9 @@ pub struct StackDesc {
     pub distribution: Distribution,
     /// Masking–shadowing for all interfaces.
     pub masking: Masking,
+    /// Absolute IOR of the medium the surface is seen from (1: air; 1.33 a coat under water),
+    /// 1 ..= 3; the top coat must be denser.
+    pub outside_ior: f32,
     /// The course's internal-reflection term `t` (eq. 3.3); `None` = the model's default (on for
     /// Course, off for Corrected; the Reference has no such term).
     pub t_term: Option<bool>,
@@ -148,6 +151,7 @@ impl StackDesc {
             fresnel: FresnelMode::Exact,
             distribution: Distribution::Blinn,
             masking: Masking::VCavity,
+            outside_ior: 1.0,
             t_term: None,
             compensation: true,
         }
@@ -273,7 +277,7 @@ impl LayeredBsdf {
     /// Validates `desc` and builds its runtime tables (a few milliseconds per coat).
     pub fn new(desc: &StackDesc) -> Result<Self, StackError> {
         validate(desc)?;
-        let mut above = 1.0f32;
+        let mut above = desc.outside_ior;
         let mut levels = Vec::with_capacity(desc.coats.len());
         for c in &desc.coats {
             let eta = c.ior / above;
@@ -416,6 +420,18 @@ pub fn validate(desc: &StackDesc) -> Result<(), StackError> {
     let bad = |what: String, value: f32, range: &'static str| {
         Err(StackError::OutOfRange { what, value, range })
     };
+    if !(desc.outside_ior >= 1.0 && desc.outside_ior <= 3.0) {
+        return bad("outside_ior".into(), desc.outside_ior, "1 ..= 3");
+    }
+    if let Some(c) = desc.coats.first()
+        && !(c.ior >= 1.0001 * desc.outside_ior)
+    {
+        return bad(
+            "coats[0].ior".into(),
+            c.ior,
+            "above 1.0001 × outside_ior (the top coat must be denser than the outside medium)",
+        );
+    }
     for (i, c) in desc.coats.iter().enumerate() {
         if !(c.ior >= 1.0001 && c.ior <= 10.0) {
             return bad(format!("coats[{i}].ior"), c.ior, "1.0001 ..= 10");
