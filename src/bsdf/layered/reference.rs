@@ -32,7 +32,8 @@ use std::f32::consts::FRAC_1_PI;
 /// Weight of the cosine lobe in the Reference model's pdf.
 const COSINE_MIX: f32 = 0.1;
 
-/// Russian roulette starts after this many bounces and kills walks whose weight is below 1/4.
+/// Russian roulette starts after this many bounces and kills walks whose weight, as it would be
+/// outside the coat, is below 1/4.
 const RR_DEPTH: u32 = 3;
 
 /// `f(wo, wi)` of the Reference model.
@@ -142,9 +143,11 @@ fn eval_at(
         let exit_a = wis.f * iface.compensation(wis.wi);
         let mut beta = wos.weight * iface.compensation(wo);
         let mut w = wos.wi; // travelling down
+        let eta2 = lv.eta * lv.eta;
         for depth in 0..p.max_depth {
-            if depth > RR_DEPTH && beta.max_channel() < 0.25 {
-                let q = (1.0 - beta.max_channel()).max(0.0);
+            let rr = beta.max_channel() * eta2;
+            if depth > RR_DEPTH && rr < 0.25 {
+                let q = (1.0 - rr).max(0.0);
                 if rng.uniform() < q {
                     break;
                 }
@@ -243,9 +246,13 @@ fn walk_at(
     }
     let mut beta = s.weight * c;
     let mut w = s.wi;
+    let eta2 = lv.eta * lv.eta;
     for depth in 0..p.max_depth {
-        if depth > RR_DEPTH && beta.max_channel() < 0.25 {
-            let q = (1.0 - beta.max_channel()).max(0.0);
+        // Roulette on the weight the walk will have outside: inside the coat `beta` carries the
+        // entering refraction's 1/η², which leaving undoes (pbrt-v4's `etaScale`, §14.1.5).
+        let rr = beta.max_channel() * eta2;
+        if depth > RR_DEPTH && rr < 0.25 {
+            let q = (1.0 - rr).max(0.0);
             if rng.uniform() < q {
                 return None;
             }
