@@ -83,7 +83,7 @@ fn all_cells(n_corr: u64, n_ref: u64) -> Vec<(String, Vec<Cell>)> {
 /// Corrected / Reference, and its standard error by first-order propagation.
 fn ratio(c: &Estimate, r: &Estimate, ch: usize) -> (f32, f32) {
     let (mc, mr) = (c.mean[ch], r.mean[ch]);
-    if !(mr > 0.0) {
+    if mr.is_nan() || mr <= 0.0 {
         return (f32::NAN, f32::NAN);
     }
     let q = mc / mr;
