@@ -308,27 +308,45 @@ fn course_model_departures_are_pinned() {
     );
 }
 
-/// Corrected model of (b) without the conductor's compensation, measured with 800 000 samples
-/// (σ ≤ 0.0008), pinned at ±0.6%.
-const PIN_B_NOCOMP: [(f32, f32); 3] = [(0.0, 0.9941), (45.0, 0.9840), (85.0, 0.9806)];
-
-/// Without the conductor's multiple-scattering compensation (Turquin 2019) the Corrected model of
-/// (b) loses the energy that V-cavity masking discards: below 1 by more than 3σ + 0.4% everywhere.
+/// Without multiple-scattering compensation (Turquin 2019 at the conductor, the interfaces'
+/// multiple-scattering lobe in the walk) stack (b) loses the energy that single-scattering
+/// masking discards at every event, more at grazing angles. The Reference walk measures that
+/// loss; the Corrected model, calibrated to the adding solution of the same uncompensated stack,
+/// follows it within 2 % (4σ added for the walk's noise). Both stay below 1 by more than 3σ + 0.4%.
 #[test]
 fn uncompensated_conductor_loses_energy() {
     let mut d = mirror_under_coat();
     d.compensation = false;
     let b = build(&d, Model::Corrected);
-    let (mut out, mut failures) = ("\n".to_string(), vec![]);
-    let label = "(b) Corrected, compensation off";
-    let cfg = (800_000, 0.006, 31);
-    let got = check_pins(label, &b, &PIN_B_NOCOMP, cfg, &mut out, &mut failures);
+    let walk = build(&d, reference());
+    let angles = [0.0f32, 45.0, 85.0];
+    let res: Vec<(Estimate, Estimate)> = angles
+        .par_iter()
+        .enumerate()
+        .map(|(i, &th)| {
+            (
+                albedo(&b, th, 200_000, 31 + i as u64),
+                albedo(&walk, th, 300_000, 35 + i as u64),
+            )
+        })
+        .collect();
+    let mut out =
+        "\n(b) compensation off: Corrected (200000 samples), Reference (300000):\n".to_string();
+    for (th, (c, r)) in angles.iter().zip(&res) {
+        out += &format!("{th:>5}° {:>15} {:>15}\n", cell(c), cell(r));
+    }
     print!("{out}");
-    assert!(failures.is_empty(), "{}", failures.join("\n"));
-    for (&(th, _), e) in PIN_B_NOCOMP.iter().zip(&got) {
+    for (th, (c, r)) in angles.iter().zip(&res) {
+        for e in [c, r] {
+            assert!(
+                e.mean[0] + 3.0 * e.std_error[0] < 0.996,
+                "θo={th}: expected an energy loss, got {e:?}"
+            );
+        }
+        let tol = 0.02 * r.mean[0] + 4.0 * (c.std_error[0].powi(2) + r.std_error[0].powi(2)).sqrt();
         assert!(
-            e.mean[0] + 3.0 * e.std_error[0] < 0.996,
-            "θo={th}: expected an energy loss, got {e:?}"
+            (c.mean[0] - r.mean[0]).abs() <= tol,
+            "θo={th}: Corrected {c:?} vs Reference {r:?}"
         );
     }
 }

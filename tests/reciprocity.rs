@@ -357,26 +357,29 @@ const COLUMNS: [&str; 6] = [
 /// Today's measured asymmetries (columns as [`COLUMNS`]); bounds are derived from them.
 #[rustfmt::skip]
 const MEASURED: [(&str, [f32; 6]); 11] = [
-    ("garnet_red_spray_paint", [0.17290, 0.00543, 0.00032, 0.00005, 0.0215, 0.0102]),
-    ("sugar", [0.16337, 0.02753, 0.00413, 0.00449, 0.0892, 0.0780]),
-    ("green_latex", [0.15077, 0.02427, 0.00127, 0.00101, 0.0675, 0.0468]),
-    ("brass", [0.11063, 0.00439, 0.57712, 0.01217, 0.4628, 0.0227]),
-    ("blue_metallic_car_paint", [0.18040, 0.00675, 0.03922, 0.00333, 0.0190, 0.0034]),
-    ("gold_car_paint", [0.18355, 0.01275, 0.04325, 0.01176, 0.0348, 0.0130]),
-    ("blue_metallic_paint", [0.00001, 0.00013, 0.26810, 0.00032, 0.1416, 0.0344]),
-    ("silver_paint", [0.18397, 0.00817, 0.35918, 0.11809, 0.3322, 0.0846]),
-    ("light_blue_house_paint", [0.14015, 0.02263, 0.00091, 0.00072, 0.0559, 0.0400]),
-    ("blue_glossy_ceramic", [0.18571, 0.03263, 0.00029, 0.00034, 0.0152, 0.0142]),
-    ("red_glossy_ceramic", [0.18571, 0.03203, 0.00235, 0.00170, 0.0216, 0.0203]),
+    ("garnet_red_spray_paint", [0.17290, 0.00543, 0.00000, 0.00000, 0.0189, 0.0014]),
+    ("sugar", [0.16337, 0.02753, 0.00000, 0.00000, 0.0736, 0.0672]),
+    ("green_latex", [0.15077, 0.02427, 0.00000, 0.00000, 0.0325, 0.0258]),
+    ("brass", [0.11063, 0.00439, 0.00000, 0.00000, 0.5733, 0.0220]),
+    ("blue_metallic_car_paint", [0.18040, 0.00675, 0.00308, 0.00132, 0.0237, 0.0035]),
+    ("gold_car_paint", [0.18355, 0.01276, 0.00113, 0.00068, 0.0369, 0.0122]),
+    ("blue_metallic_paint", [0.00001, 0.00013, 0.00000, 0.00000, 0.0522, 0.0478]),
+    ("silver_paint", [0.18398, 0.00817, 0.00018, 0.00010, 0.3323, 0.0760]),
+    ("light_blue_house_paint", [0.14015, 0.02263, 0.00000, 0.00000, 0.0263, 0.0220]),
+    ("blue_glossy_ceramic", [0.18571, 0.03263, 0.00000, 0.00000, 0.0141, 0.0145]),
+    ("red_glossy_ceramic", [0.18571, 0.03203, 0.00000, 0.00000, 0.0214, 0.0197]),
 ];
 
-/// Without energy compensation (a per-`wo` factor, non-reciprocal by construction) the Reference
-/// walk is reciprocal in expectation: its asymmetry, a mean of |differences of two estimates|, has
-/// the same expectation as its noise floor. Over 180 pairs at 256 walks per evaluation the ratio
-/// of the two L1 measures is 0.83–1.04 today; a bound of 1.5 flags a non-reciprocity half the size
-/// of the noise (with compensation, garnet_red_spray_paint shows 15×).
+/// The Reference walk is reciprocal in expectation, without and with energy compensation: its
+/// asymmetry, a mean of |differences of two estimates|, has the same expectation as its noise
+/// floor. Over 180 pairs at 256 walks per evaluation the ratio of the two L1 measures is
+/// 0.85–1.05 (off and on); a bound of 1.5 flags a non-reciprocity half the size of the noise.
+/// (Compensation used to scale each interface event by `1/E(wo)`, which is not reciprocal:
+/// garnet_red_spray_paint then showed 15× its noise. The interfaces' multiple-scattering lobe
+/// (`bsdf::interface_energy`) keeps detailed balance; the conductor's Turquin factor, the one
+/// per-`wo` factor left, is within the noise for silver_paint.)
 #[test]
-fn uncompensated_reference_is_reciprocal_within_noise() {
+fn reference_is_reciprocal_within_noise() {
     let lib = MaterialLibrary::course();
     let names = [
         "garnet_red_spray_paint",
@@ -414,11 +417,13 @@ fn uncompensated_reference_is_reciprocal_within_noise() {
             non.1,
             on.l1 / non.1
         );
-        if !holds(off.l1 <= 1.5 * noff.1) {
-            failures.push(format!(
-                "{n}: L1 asymmetry {:.4} > 1.5 × noise {:.4}",
-                off.l1, noff.1
-            ));
+        for (label, m, noise) in [("off", off, noff), ("on", on, non)] {
+            if !holds(m.l1 <= 1.5 * noise.1) {
+                failures.push(format!(
+                    "{n} compensation {label}: L1 asymmetry {:.4} > 1.5 × noise {:.4}",
+                    m.l1, noise.1
+                ));
+            }
         }
     }
     print!("{out}");

@@ -301,8 +301,8 @@ fn closed_form(
 // The implemented interface, measured.
 
 /// Mean reflection and transmission weights of lapidary's `RoughDielectric` at roughness `m`
-/// (importance mode: no η² factors, which cancel in the walk), each event times the compensation
-/// `1/E(wo)` the walk applies, by stratified sampling (a near-mirror interface has almost no
+/// (importance mode: no η² factors, which cancel in the walk), with the multiple-scattering lobe
+/// the walk uses, by stratified sampling (a near-mirror interface has almost no
 /// variance). Cached per cosine: the same nodes recur for every optical depth.
 /// `((μ bits, inside), (R, T))`.
 type CacheEntry = ((u64, bool), (f64, f64));
@@ -341,7 +341,7 @@ impl Measured {
                 }
             }
         }
-        sum / (GRID * GRID) as f64 * f64::from(self.iface.compensation(wo))
+        sum / (GRID * GRID) as f64
     }
 }
 

@@ -10,6 +10,7 @@
 //! the side above. Transmission in [`TransportMode::Radiance`] carries the `1/η'²` radiance
 //! scaling; [`TransportMode::Importance`] omits it, so `f_rad(wo, wi) = f_imp(wi, wo)`.
 
+use super::interface_energy::InterfaceEnergy;
 use super::table::Table;
 use super::{
     BsdfSample, Bxdf, Lobe, LobeFlags, LobeKind, MicrofacetDistribution, TransportMode, fresnel,
@@ -31,17 +32,6 @@ pub enum Lobes {
     Transmission,
 }
 
-/// Directional albedo `R + T` of an interface (flux, i.e. importance transport) from each side, for
-/// multiple-scattering compensation: scaling every event by `1/E(wo)` (Turquin 2019 applied to a
-/// lossless dielectric) returns the energy that single-scattering masking discards.
-#[derive(Clone, Debug, PartialEq)]
-pub struct InterfaceEnergy {
-    /// `E(μ)` for `wo` above the interface.
-    pub above: Table,
-    /// `E(μ)` for `wo` below the interface (`μ = |cos θo|`).
-    pub below: Table,
-}
-
 /// A rough dielectric interface.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RoughDielectric {
@@ -49,7 +39,8 @@ pub struct RoughDielectric {
     pub distribution: MicrofacetDistribution,
     /// Relative IOR, below / above.
     pub eta: f32,
-    /// Optional energy tables for compensation ([`Self::compensation`]).
+    /// Optional multiple-scattering lobe that returns the energy single scattering loses,
+    /// reciprocally ([`InterfaceEnergy`]).
     pub energy: Option<Arc<InterfaceEnergy>>,
 }
 
@@ -63,39 +54,48 @@ impl RoughDielectric {
         }
     }
 
-    /// Builds the compensation tables (~10 ms).
+    /// The same interface with its multiple-scattering lobe ([`InterfaceEnergy`]): measures the
+    /// single-scattering reflection and transmission from each side (~10 ms) and builds the lobe
+    /// that returns the missing flux reciprocally. A near-smooth interface loses nothing and gets
+    /// no lobe.
     pub fn with_energy_tables(mut self) -> Self {
         let plain = RoughDielectric::new(self.distribution, self.eta);
+        // Reflection and transmission sampled separately with the same numbers: their split is
+        // then free of the binomial noise of choosing between them.
         let table = |sign: f32| {
             Table::by_sampling(
-                32,
+                16,
                 hash_words(&[0xd1e1, sign.to_bits() as u64]),
                 |wo, uc, u| {
                     let wo = Vec3::new(wo.x, wo.y, sign * wo.z);
-                    plain
-                        .sample_lobes(wo, uc, u, TransportMode::Importance, Lobes::All)
-                        .map_or(RgbSample::ZERO, |s| s.weight)
+                    let weight = |lobes| {
+                        plain
+                            .sample_lobes(wo, uc, u, TransportMode::Importance, lobes)
+                            .map_or(0.0, |s| s.weight[0])
+                    };
+                    RgbSample([weight(Lobes::Reflection), weight(Lobes::Transmission), 0.0])
                 },
             )
         };
-        self.energy = Some(Arc::new(InterfaceEnergy {
-            above: table(1.0),
-            below: table(-1.0),
-        }));
+        self.energy = InterfaceEnergy::new(table(1.0), table(-1.0), self.eta).map(Arc::new);
         self
     }
 
-    /// The compensation factor `1/E(wo)` for an event whose radiance-side direction is `wo`
-    /// (1 without tables).
+    /// Probability that a sample from `wo` with `lobes` allowed is drawn from the
+    /// multiple-scattering lobe: its share of the flux those lobes carry.
     #[inline]
-    pub fn compensation(&self, wo: Vec3) -> f32 {
-        match &self.energy {
-            None => 1.0,
-            Some(e) => {
-                let t = if wo.z >= 0.0 { &e.above } else { &e.below };
-                1.0 / t.at(wo.z.abs())[0].clamp(0.05, 1.0)
-            }
-        }
+    fn p_multiple(&self, wo: Vec3, lobes: Lobes) -> f32 {
+        let Some(e) = &self.energy else {
+            return 0.0;
+        };
+        let (r, t) = e.single(wo);
+        let (mr, mt) = e.split(wo);
+        let (ms, ss) = match lobes {
+            Lobes::All => (mr + mt, r + t),
+            Lobes::Reflection => (mr, r),
+            Lobes::Transmission => (mt, t),
+        };
+        if ms + ss > 0.0 { ms / (ms + ss) } else { 0.0 }
     }
 
     /// The generalised half vector (Walter eq. 16), facing `+z`; `None` when undefined or when a
@@ -129,8 +129,25 @@ impl RoughDielectric {
         Some((h, reflect, etap))
     }
 
-    /// `f(wo, wi)` in sr⁻¹ (cosine excluded) for directions on either side.
+    /// `f(wo, wi)` in sr⁻¹ (cosine excluded) for directions on either side: single scattering plus
+    /// the multiple-scattering lobe when the interface has one.
     pub fn value(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> f32 {
+        let ss = self.value_single(wo, wi, mode);
+        match &self.energy {
+            None => ss,
+            Some(e) => {
+                let v = ss + e.value(wo, wi, mode);
+                if v.is_finite() && v >= super::F_FLUSH {
+                    v
+                } else {
+                    0.0
+                }
+            }
+        }
+    }
+
+    /// The single-scattering part of [`Self::value`] (Walter et al. 2007, eqs. 20–21).
+    fn value_single(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> f32 {
         let Some((h, is_reflect, etap)) = self.half(wo, wi) else {
             return 0.0;
         };
@@ -164,6 +181,22 @@ impl RoughDielectric {
 
     /// Density of sampling `wi` from `wo` with the given lobes allowed.
     pub fn pdf_lobes(&self, wo: Vec3, wi: Vec3, lobes: Lobes) -> f32 {
+        let ss = self.pdf_single(wo, wi, lobes);
+        match &self.energy {
+            None => ss,
+            Some(e) => {
+                let pm = self.p_multiple(wo, lobes);
+                let (rf, tr) = (lobes != Lobes::Transmission, lobes != Lobes::Reflection);
+                let allowed = if wo.z * wi.z > 0.0 { rf } else { tr };
+                let ms = if allowed { e.pdf(wo, wi, rf, tr) } else { 0.0 };
+                let p = pm * ms + (1.0 - pm) * ss;
+                if p.is_finite() { p.max(0.0) } else { 0.0 }
+            }
+        }
+    }
+
+    /// Density of the single-scattering sampler alone.
+    fn pdf_single(&self, wo: Vec3, wi: Vec3, lobes: Lobes) -> f32 {
         let Some((h, is_reflect, etap)) = self.half(wo, wi) else {
             return 0.0;
         };
@@ -206,6 +239,16 @@ impl RoughDielectric {
         if wo.z == 0.0 {
             return None;
         }
+        let mut uc = uc.clamp(0.0, 1.0);
+        if let Some(e) = &self.energy {
+            let pm = self.p_multiple(wo, lobes);
+            if uc < pm {
+                let (rf, tr) = (lobes != Lobes::Transmission, lobes != Lobes::Reflection);
+                let wi = e.sample(wo, (uc / pm).min(1.0), u, rf, tr)?;
+                return self.finish_sample(wo, wi, mode, lobes);
+            }
+            uc = ((uc - pm) / (1.0 - pm)).clamp(0.0, 1.0);
+        }
         let (h, uc) = self.distribution.sample_visible(wo, uc, u)?;
         let oh = wo.dot(h);
         if oh * wo.z <= 0.0 {
@@ -233,6 +276,18 @@ impl RoughDielectric {
             }
             wi
         };
+        self.finish_sample(wo, wi, mode, lobes)
+    }
+
+    /// The sample record for a direction drawn by [`Self::sample_lobes`]: `f` and `pdf` of the
+    /// whole mixture.
+    fn finish_sample(
+        &self,
+        wo: Vec3,
+        wi: Vec3,
+        mode: TransportMode,
+        lobes: Lobes,
+    ) -> Option<BsdfSample> {
         let f = self.value(wo, wi, mode);
         let pdf = self.pdf_lobes(wo, wi, lobes);
         let (kind, eta) = if wi.z * wo.z > 0.0 {
@@ -313,9 +368,23 @@ mod tests {
             }
             let mean = sum / n as f64;
             assert!(mean > 0.95 && mean < 1.005, "side {side}: {mean}");
-            // With the energy tables, 1/E(wo) scales the mean back to 1.
-            let c = g.clone().with_energy_tables().compensation(wo) as f64;
-            assert!((mean * c - 1.0).abs() < 0.01, "side {side}: {}", mean * c);
+            // With the multiple-scattering lobe every direction keeps all its flux.
+            let full = g.clone().with_energy_tables();
+            let mut rng = crate::sampler::Rng::new(4);
+            let mut sum = 0.0f64;
+            for _ in 0..n {
+                if let Some(s) = full.sample_lobes(
+                    wo,
+                    rng.uniform(),
+                    rng.uniform2(),
+                    TransportMode::Importance,
+                    Lobes::All,
+                ) {
+                    sum += f64::from(s.weight[0]);
+                }
+            }
+            let full_mean = sum / n as f64;
+            assert!((full_mean - 1.0).abs() < 0.01, "side {side}: {full_mean}");
         }
     }
 }

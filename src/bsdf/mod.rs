@@ -25,6 +25,7 @@
 
 pub mod dielectric;
 pub mod fresnel;
+pub mod interface_energy;
 pub mod lambert;
 pub mod layered;
 pub mod masking;

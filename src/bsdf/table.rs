@@ -84,6 +84,19 @@ impl Table {
         })
     }
 
+    /// A table holding `values[i]` at `entry_cos(i)`; `values` must have [`ENTRIES`] entries.
+    pub fn from_values(values: Vec<RgbSample>) -> Self {
+        assert_eq!(values.len(), ENTRIES, "a table has {ENTRIES} entries");
+        Table {
+            values: values.into_boxed_slice(),
+        }
+    }
+
+    /// The entries, at `entry_cos(i)`.
+    pub fn values(&self) -> &[RgbSample] {
+        &self.values
+    }
+
     /// A table of zeros.
     pub fn zero() -> Self {
         Table {

@@ -31,22 +31,41 @@ use crate::spectrum::RgbSample;
 use glam::{Vec2, Vec3};
 use std::f32::consts::{FRAC_1_PI, PI};
 
-/// `f(wo, wi)` of the Corrected model at stack level `l` (`l == coats` = the base).
+/// `f(wo, wi)` of the Corrected model at stack level `l` (`l == coats` = the base): the top lobe
+/// plus the body, the body of the outermost level scaled by the stack's albedo calibration
+/// `c(μo) c(μi)` when it has one ([`super::calibrate`]).
 pub fn eval(stack: &LayeredBsdf, l: usize, wo: Vec3, wi: Vec3) -> RgbSample {
+    let (top, body) = eval_parts(stack, l, wo, wi);
+    match (&stack.calibration, l) {
+        (Some(c), 0) if !body.is_black() => top + body * c.at(wo.z) * c.at(wi.z),
+        _ => top + body,
+    }
+}
+
+/// The two parts of the Corrected `f` at level `l`, uncalibrated: the top interface's reflection
+/// and the body (single-scatter lobe of the layers below plus the multiple-reflection lobe). At the
+/// base, everything is "top".
+pub(super) fn eval_parts(
+    stack: &LayeredBsdf,
+    l: usize,
+    wo: Vec3,
+    wi: Vec3,
+) -> (RgbSample, RgbSample) {
     let Some(lv) = stack.levels.get(l) else {
-        return stack.base.eval(wo, wi);
+        return (stack.base.eval(wo, wi), RgbSample::ZERO);
     };
     if wo.z <= 0.0 || wi.z <= 0.0 {
-        return RgbSample::ZERO;
+        return (RgbSample::ZERO, RgbSample::ZERO);
     }
-    let mut f = lv.top.eval(wo, wi);
+    let top = lv.top.eval(wo, wi);
     let Some(wo_in) = refract_macro(wo, lv.eta) else {
-        return f;
+        return (top, RgbSample::ZERO);
     };
     let (to, ti) = (lv.t(wo.z), lv.t(wi.z));
     let Some(wi_in) = refract_macro(wi, lv.eta) else {
-        return f;
+        return (top, RgbSample::ZERO);
     };
+    let mut body = RgbSample::ZERO;
     {
         let rest = eval(stack, l + 1, wo_in, wi_in);
         if !rest.is_black() {
@@ -61,13 +80,16 @@ pub fn eval(stack: &LayeredBsdf, l: usize, wo: Vec3, wi: Vec3) -> RgbSample {
             } else {
                 to
             };
-            f += rest * lv.absorb(wo_in.z, wi_in.z) * (ti * exit / (lv.eta * lv.eta));
+            body = rest * lv.absorb(wo_in.z, wi_in.z) * (ti * exit / (lv.eta * lv.eta));
         }
     }
     // Symmetric multiple-reflection lobe M · q(wo) q(wi) / ∫q cos (module docs); q(wi) = 0
     // when wi cannot be reached from inside.
     let qi = lv.trapped.at(wi_in.z) * ti;
-    f + lv.trapped.at(wo_in.z) * qi * lv.multi_scale * to
+    (
+        top,
+        body + lv.trapped.at(wo_in.z) * qi * lv.multi_scale * to,
+    )
 }
 
 /// Evaluates level `l` under the analytic model selected by `corrected`.
@@ -86,7 +108,7 @@ const LOBE_FLOOR: f32 = 1e-5;
 /// Lobe-selection weights `[top, rest, multiple]` at level `l` for `wo` (sum 1, or all 0 when the
 /// level reflects nothing), and the refracted `wo'`.
 #[inline]
-fn lobe_weights(
+pub(super) fn lobe_weights(
     stack: &LayeredBsdf,
     l: usize,
     wo: Vec3,
@@ -101,8 +123,16 @@ fn lobe_weights(
         let a = lv.albedo_rest.at(wi.z);
         let q = lv.trapped.at(wi.z);
         if corrected {
-            w[1] = t * (a - q).luminance().max(0.0);
-            w[2] = t * (q * lv.multi_albedo).luminance().max(0.0);
+            // The calibration scales the body's albedo by about c(μo)².
+            let c2 = match (&stack.calibration, l) {
+                (Some(c), 0) => {
+                    let c = c.at(wo.z);
+                    (c * c).luminance().max(0.0)
+                }
+                _ => 1.0,
+            };
+            w[1] = t * c2 * (a - q).luminance().max(0.0);
+            w[2] = t * c2 * (q * lv.multi_albedo).luminance().max(0.0);
         } else {
             w[1] = t * a.luminance().max(0.0);
         }
@@ -187,7 +217,7 @@ pub fn pdf(stack: &LayeredBsdf, l: usize, wo: Vec3, wi: Vec3, corrected: bool) -
 }
 
 /// Samples a direction from the mixture at level `l` (no evaluation).
-fn sample_dir(
+pub(super) fn sample_dir(
     stack: &LayeredBsdf,
     l: usize,
     wo: Vec3,

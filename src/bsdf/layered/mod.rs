@@ -17,6 +17,8 @@
 //! lands there fails, and its energy is what the multiple-reflection lobe (Corrected) or the `t`
 //! term (Course) stands in for.
 
+pub mod adding;
+pub mod calibrate;
 pub mod corrected;
 pub mod course;
 pub mod reference;
@@ -264,6 +266,9 @@ pub struct LayeredBsdf {
     /// The recipe's explicit `t_term`, if any (the default depends on the current model).
     pub(crate) t_term: Option<bool>,
     pub(crate) compensation: bool,
+    /// The Corrected model's albedo calibration `c(μ)` of the outermost body ([`calibrate`]);
+    /// `None` until a Corrected stack without the `t` term is prepared.
+    pub(crate) calibration: Option<std::sync::Arc<Table>>,
     pub(crate) fresnel: FresnelMode,
     pub(crate) distribution: Distribution,
     pub(crate) masking: Masking,
@@ -338,6 +343,7 @@ impl LayeredBsdf {
             model: desc.model,
             t_term,
             compensation: desc.compensation,
+            calibration: None,
             fresnel: desc.fresnel,
             distribution: desc.distribution,
             masking: desc.masking,
@@ -349,9 +355,18 @@ impl LayeredBsdf {
         Ok(stack)
     }
 
-    /// Builds what the current model needs beyond the shared tables (the interfaces' energy tables
-    /// for a compensated Reference walk).
+    /// Builds what the current model needs beyond the shared tables: the albedo calibration of
+    /// Corrected (unless the `t` term is on: the course's own approximation of internal
+    /// reflection is then measured as it is), the interfaces' energy tables for a compensated
+    /// Reference walk.
     fn prepare_model(&mut self) {
+        if self.model == Model::Corrected
+            && !self.t_term()
+            && self.calibration.is_none()
+            && !self.levels.is_empty()
+        {
+            self.calibration = Some(std::sync::Arc::new(calibrate::calibration(self)));
+        }
         if matches!(self.model, Model::Reference(_)) && self.compensation {
             for lv in self.levels.iter_mut() {
                 if lv.interface.energy.is_none() && !lv.index_matched {

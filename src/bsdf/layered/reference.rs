@@ -117,8 +117,7 @@ fn eval_at(
         return a * eval_at(stack, p, l + 1, wo, wi, rng);
     }
     let iface = &lv.interface;
-    let f_top =
-        RgbSample::splat(iface.value(wo, wi, TransportMode::Radiance) * iface.compensation(wo));
+    let f_top = RgbSample::splat(iface.value(wo, wi, TransportMode::Radiance));
     let mut acc = RgbSample::ZERO;
     for _ in 0..p.samples {
         let Some(wos) = iface.sample_lobes(
@@ -139,9 +138,9 @@ fn eval_at(
         ) else {
             continue;
         };
-        // The exit event's radiance-side direction is the inner one, so its compensation is 1/E(wis).
-        let exit_a = wis.f * iface.compensation(wis.wi);
-        let mut beta = wos.weight * iface.compensation(wo);
+        // `wis.f` in importance mode is the exit event's radiance BSDF f(wis.wi → wi).
+        let exit_a = wis.f;
+        let mut beta = wos.weight;
         let mut w = wos.wi; // travelling down
         let eta2 = lv.eta * lv.eta;
         for depth in 0..p.max_depth {
@@ -172,7 +171,7 @@ fn eval_at(
             beta *= wtb;
             w = wb; // travelling up
             // Strategy B: evaluate the interface's transmission toward wi.
-            let fe = iface.value(-w, wi, TransportMode::Radiance) * iface.compensation(-w);
+            let fe = iface.value(-w, wi, TransportMode::Radiance);
             if fe > 0.0 {
                 let pa = iface.pdf_lobes(wi, -w, Lobes::Transmission);
                 let wt = power_heuristic(pdf_b, pa);
@@ -189,7 +188,7 @@ fn eval_at(
             ) else {
                 break;
             };
-            beta *= rs.weight * iface.compensation(-w);
+            beta *= rs.weight;
             w = rs.wi;
             if beta.is_black() {
                 break;
@@ -240,11 +239,10 @@ fn walk_at(
     let iface = &lv.interface;
     let (uc, u) = first.unwrap_or_else(|| (rng.uniform(), rng.uniform2()));
     let s = iface.sample_lobes(wo, uc, u, TransportMode::Radiance, Lobes::All)?;
-    let c = iface.compensation(wo);
     if s.wi.z > 0.0 {
-        return Some((s.wi, s.weight * c));
+        return Some((s.wi, s.weight));
     }
-    let mut beta = s.weight * c;
+    let mut beta = s.weight;
     let mut w = s.wi;
     let eta2 = lv.eta * lv.eta;
     for depth in 0..p.max_depth {
@@ -268,7 +266,7 @@ fn walk_at(
             TransportMode::Radiance,
             Lobes::All,
         )?;
-        beta *= s.weight * iface.compensation(-wb);
+        beta *= s.weight;
         if s.wi.z > 0.0 {
             return Some((s.wi, beta));
         }
