@@ -11,6 +11,7 @@
 //! scaling; [`TransportMode::Importance`] omits it, so `f_rad(wo, wi) = f_imp(wi, wo)`.
 
 use super::interface_energy::InterfaceEnergy;
+use super::memo::Memo;
 use super::table::Table;
 use super::{
     BsdfSample, Bxdf, Lobe, LobeFlags, LobeKind, MicrofacetDistribution, TransportMode, fresnel,
@@ -31,6 +32,11 @@ pub enum Lobes {
     /// Transmission only (the weight then carries `1 − F`).
     Transmission,
 }
+
+/// Interfaces that differ only in where they are used share one lobe: a gem's materials often
+/// repeat a coat (same distribution, roughness and IOR), and the tables take ~10 ms each.
+type EnergyKey = (super::Distribution, super::Masking, u32, u32);
+static ENERGY: Memo<EnergyKey, Option<Arc<InterfaceEnergy>>> = Memo::new(4096);
 
 /// A rough dielectric interface.
 #[derive(Clone, Debug, PartialEq)]
@@ -59,12 +65,22 @@ impl RoughDielectric {
     /// that returns the missing flux reciprocally. A near-smooth interface loses nothing and gets
     /// no lobe.
     pub fn with_energy_tables(mut self) -> Self {
+        let d = self.distribution;
+        let key = (d.kind(), d.masking(), d.alpha().to_bits(), self.eta.to_bits());
+        self.energy = ENERGY.get_or_build(key, || self.build_energy());
+        self
+    }
+
+    /// Measures the single-scattering tables and builds the lobe (uncached).
+    fn build_energy(&self) -> Option<Arc<InterfaceEnergy>> {
         let plain = RoughDielectric::new(self.distribution, self.eta);
         // Reflection and transmission sampled separately with the same numbers: their split is
         // then free of the binomial noise of choosing between them.
         let table = |sign: f32| {
+            // 4096 samples per entry: ~0.2 % rms in E at any angle (1024 gave up to 1.7 % at
+            // grazing for m 45°), and the lobe returns exactly 1 − E.
             Table::by_sampling(
-                16,
+                32,
                 hash_words(&[0xd1e1, sign.to_bits() as u64]),
                 |wo, uc, u| {
                     let wo = Vec3::new(wo.x, wo.y, sign * wo.z);
@@ -77,8 +93,7 @@ impl RoughDielectric {
                 },
             )
         };
-        self.energy = InterfaceEnergy::new(table(1.0), table(-1.0), self.eta).map(Arc::new);
-        self
+        InterfaceEnergy::new(table(1.0), table(-1.0), self.eta).map(Arc::new)
     }
 
     /// Probability that a sample from `wo` with `lobes` allowed is drawn from the

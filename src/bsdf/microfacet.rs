@@ -122,13 +122,17 @@ impl MicrofacetDistribution {
             return 0.0;
         }
         let s2 = super::sin2_theta(h);
-        if s2 >= 1.0 {
-            return 0.0;
-        }
-        match self.ndf {
+        let d = match self.ndf {
             Ndf::Blinn { exponent: e } => {
-                let log_cos_e = 0.5 * e * (-s2).ln_1p();
-                (e + 2.0) / (2.0 * PI) * log_cos_e.exp()
+                // ln cos θh from the tangential part near the normal (where 1 − z² cancels) and
+                // from z near the horizon (where sin² θh rounds to 1 in f32 although cos θh > 0:
+                // D is not 0 there for e ≤ 0, and both argument orders of a pair must agree).
+                let log_cos = if s2 < 0.5 {
+                    0.5 * (-s2).ln_1p()
+                } else {
+                    h.z.ln()
+                };
+                (e + 2.0) / (2.0 * PI) * (e * log_cos).exp()
             }
             Ndf::Beckmann => {
                 let c2 = if s2 < 0.5 { 1.0 - s2 } else { h.z * h.z };
@@ -143,7 +147,8 @@ impl MicrofacetDistribution {
                 let k = a2 * c2 + s2;
                 a2 / (PI * k * k)
             }
-        }
+        };
+        if d.is_finite() { d } else { 0.0 }
     }
 
     /// Density of [`Self::sample_h`]: `D(h) cos θh` per steradian of `h`.

@@ -30,6 +30,7 @@ pub mod lambert;
 pub mod layered;
 pub mod masking;
 pub mod measure;
+pub mod memo;
 pub mod microfacet;
 pub mod names;
 pub mod oren_nayar;

@@ -11,6 +11,7 @@
 //! discards and that further bounces on the micro-surface would reflect; a perfect conductor then has
 //! albedo 1 at every angle. It depends on `wo` only, so it is not reciprocal.
 
+use super::memo::Memo;
 use super::table::Table;
 use super::{Bsdf, Lobe, LobeFlags, LobeKind, TransportMode, flush_tiny};
 use super::{BsdfSample, Bxdf, Fresnel, MicrofacetDistribution, reflect};
@@ -18,6 +19,10 @@ use crate::sampler::hash_words;
 use crate::spectrum::RgbSample;
 use glam::{Vec2, Vec3};
 use std::sync::Arc;
+
+/// Single-scattering albedo tables at `F = 1`, shared by every lobe with the same distribution.
+type ESsKey = (super::Distribution, super::Masking, u32);
+static E_SS: Memo<ESsKey, Arc<Table>> = Memo::new(4096);
 
 /// Multiple-scattering compensation data (module docs).
 #[derive(Clone, Debug, PartialEq)]
@@ -49,16 +54,25 @@ impl TorranceSparrow {
         }
     }
 
-    /// The same lobe with multiple-scattering compensation (builds its table, ~2 ms).
+    /// The same lobe with multiple-scattering compensation (builds its table, ~2 ms, once per
+    /// distribution: the table does not depend on the Fresnel factor).
     pub fn with_compensation(mut self) -> Self {
-        let plain = TorranceSparrow::new(self.distribution, Fresnel::Perfect);
-        let e_ss = Table::by_sampling(32, hash_words(&[0xc0_4e05]), |wo, uc, u| {
-            plain
-                .sample(wo, uc, u)
-                .map_or(RgbSample::ZERO, |s| s.weight)
+        let d = self.distribution;
+        let key = (d.kind(), d.masking(), d.alpha().to_bits());
+        let e_ss = E_SS.get_or_build(key, || {
+            let plain = TorranceSparrow::new(d, Fresnel::Perfect);
+            Arc::new(Table::by_sampling(
+                32,
+                hash_words(&[0xc0_4e05]),
+                |wo, uc, u| {
+                    plain
+                        .sample(wo, uc, u)
+                        .map_or(RgbSample::ZERO, |s| s.weight)
+                },
+            ))
         });
         self.compensation = Some(Compensation {
-            e_ss: Arc::new(e_ss),
+            e_ss,
             f0: self.fresnel.eval(1.0),
         });
         self

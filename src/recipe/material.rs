@@ -26,7 +26,8 @@ use serde::{Deserialize, Serialize};
 pub struct CoatDesc {
     /// Absolute IOR of the varnish, 1.0001 ..= 10.
     pub ior: f32,
-    /// RMS micro-facet slope angle in degrees, 0.01 ..< 90 (`α = tan m`). Exclusive with
+    /// RMS micro-facet slope angle in degrees, 0.01 ..< 90 (`α = tan m`), or exactly 0 for a
+    /// perfectly smooth (specular, delta) top coat. Exclusive with
     /// `alpha`; one of them is required.
     #[serde(default)]
     pub roughness: Option<f32>,
@@ -110,9 +111,13 @@ fn slope_angle(roughness: Option<f32>, alpha: Option<f32>, what: &str) -> Result
     match (roughness, alpha) {
         (Some(m), None) => Ok(m),
         (None, Some(a)) => {
+            if a == 0.0 {
+                // A perfectly smooth interface, like `roughness: 0`.
+                return Ok(0.0);
+            }
             if !(ALPHA_RANGE.0..=ALPHA_RANGE.1).contains(&a) {
                 return Err(format!(
-                    "{what}.alpha = {a} is out of range: allowed {} ..= {}",
+                    "{what}.alpha = {a} is out of range: allowed 0 (smooth) or {} ..= {}",
                     ALPHA_RANGE.0, ALPHA_RANGE.1
                 ));
             }

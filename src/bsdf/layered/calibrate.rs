@@ -29,7 +29,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 /// Sampling grid per node for the body's transfer and the target (`GRID² · UC_STRATA` samples).
-const GRID: usize = 24;
+const GRID: usize = 16;
 
 /// The calibration is solved on every [`STRIDE`]-th table entry (22 nodes at `cos θ = k/21`) and
 /// interpolated linearly between them, which the table's own interpolation then reproduces
@@ -76,7 +76,8 @@ fn row(stack: &LayeredBsdf, o: usize) -> Row {
             return;
         }
         // The body lobes' own mixture density.
-        let pdf = (corrected::pdf(stack, 0, wo, wi, true) - w[0] * lv.top.pdf(wo, wi)) / body_share;
+        let top_pdf = if lv.smooth { 0.0 } else { lv.top.pdf(wo, wi) };
+        let pdf = (corrected::pdf(stack, 0, wo, wi, true) - w[0] * top_pdf) / body_share;
         if !(pdf > 0.0) || !pdf.is_finite() {
             return;
         }

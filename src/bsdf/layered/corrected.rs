@@ -57,7 +57,12 @@ pub(super) fn eval_parts(
     if wo.z <= 0.0 || wi.z <= 0.0 {
         return (RgbSample::ZERO, RgbSample::ZERO);
     }
-    let top = lv.top.eval(wo, wi);
+    // A smooth coat's reflection is a delta: never reached by evaluation.
+    let top = if lv.smooth {
+        RgbSample::ZERO
+    } else {
+        lv.top.eval(wo, wi)
+    };
     let Some(wo_in) = refract_macro(wo, lv.eta) else {
         return (top, RgbSample::ZERO);
     };
@@ -71,7 +76,7 @@ pub(super) fn eval_parts(
         if !rest.is_black() {
             let exit = if stack.t_term() {
                 let h = (wo + wi).normalize_or_zero();
-                let g = if h.z > 0.0 {
+                let g = if h.z > 0.0 && !lv.smooth {
                     lv.top.distribution.g(wo, wi, h)
                 } else {
                     1.0
@@ -197,7 +202,7 @@ pub fn pdf(stack: &LayeredBsdf, l: usize, wo: Vec3, wi: Vec3, corrected: bool) -
     }
     let (w, wo_in) = lobe_weights(stack, l, wo, corrected);
     let mut p = 0.0;
-    if w[0] > 0.0 {
+    if w[0] > 0.0 && !lv.smooth {
         p += w[0] * lv.top.pdf(wo, wi);
     }
     if w[1] > 0.0
@@ -243,6 +248,15 @@ pub(super) fn sample_dir(
     if uc < w[0] || (w[1] == 0.0 && w[2] == 0.0) {
         if w[0] == 0.0 {
             return None;
+        }
+        if lv.smooth {
+            return Some((
+                Vec3::new(-wo.x, -wo.y, wo.z),
+                Lobe {
+                    kind: LobeKind::SpecularReflection,
+                    layer: l as u8,
+                },
+            ));
         }
         let s = lv.top.sample(wo, (uc / w[0]).min(1.0), u)?;
         return Some((
@@ -291,6 +305,15 @@ pub fn sample(
     corrected: bool,
 ) -> Option<BsdfSample> {
     let (wi, lobe) = sample_dir(stack, l, wo, uc, u, corrected)?;
+    if lobe.kind == LobeKind::SpecularReflection {
+        // The smooth top coat's delta: it carries F(μo) of the flux and was chosen with the
+        // top lobe's weight; f = F/|cos θi| so that weight = f |cos θi| / pdf (the delta
+        // convention of `SmoothDielectric`).
+        let lv = &stack.levels[l];
+        let (w, _) = lobe_weights(stack, l, wo, corrected);
+        let value = lv.fresnel.eval(wo.z)[0];
+        return BsdfSample::from_eval(wi, RgbSample::splat(value / wi.z), w[0], lobe);
+    }
     let f = crate::bsdf::flush_tiny(eval_model(stack, l, wo, wi, corrected));
     BsdfSample::from_eval(wi, f, pdf(stack, l, wo, wi, corrected), lobe)
 }
@@ -301,10 +324,16 @@ pub fn sample(
 pub(super) fn build_tables(stack: &mut LayeredBsdf, l: usize, grid: usize) {
     let n2 = (grid * grid * crate::bsdf::table::UC_STRATA) as f32;
     let top = stack.levels[l].top.clone();
-    stack.levels[l].e_top = Table::by_sampling(grid, hash_words(&[l as u64, 1]), |wo, uc, u| {
-        top.sample(wo, uc, u)
-            .map_or(RgbSample::ZERO, |s| s.weight.map(|w| w.min(1e3)))
-    })
+    stack.levels[l].e_top = if stack.levels[l].smooth {
+        // A delta reflection's albedo is the Fresnel factor itself.
+        let fresnel = stack.levels[l].fresnel.clone();
+        Table::build(|mu| RgbSample::splat(fresnel.eval(mu)[0]))
+    } else {
+        Table::by_sampling(grid, hash_words(&[l as u64, 1]), |wo, uc, u| {
+            top.sample(wo, uc, u)
+                .map_or(RgbSample::ZERO, |s| s.weight.map(|w| w.min(1e3)))
+        })
+    }
     .map(|e| e.min(1.0));
 
     let (eta, od) = (stack.levels[l].eta, stack.levels[l].od);

@@ -19,7 +19,11 @@ pub fn eval(stack: &LayeredBsdf, l: usize, wo: Vec3, wi: Vec3) -> RgbSample {
     if wo.z <= 0.0 || wi.z <= 0.0 {
         return RgbSample::ZERO;
     }
-    let mut f = lv.top.eval(wo, wi);
+    let mut f = if lv.smooth {
+        RgbSample::ZERO
+    } else {
+        lv.top.eval(wo, wi)
+    };
     let (Some(wo_in), Some(wi_in)) = (refract_macro(wo, lv.eta), refract_macro(wi, lv.eta)) else {
         return f;
     };
@@ -30,7 +34,7 @@ pub fn eval(stack: &LayeredBsdf, l: usize, wo: Vec3, wi: Vec3) -> RgbSample {
     let t12 = 1.0 - lv.fresnel.eval(wi.z)[0];
     let t = if stack.t_term() {
         let h = (wo + wi).normalize_or_zero();
-        let g = if h.z > 0.0 {
+        let g = if h.z > 0.0 && !lv.smooth {
             lv.top.distribution.g(wo, wi, h)
         } else {
             1.0

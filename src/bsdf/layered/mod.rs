@@ -20,10 +20,12 @@
 pub mod adding;
 pub mod calibrate;
 pub mod corrected;
+pub mod interface;
 pub mod course;
 pub mod reference;
 
 use super::table::Table;
+use interface::CoatInterface;
 use super::{
     Bsdf, BsdfSample, Bxdf, Distribution, Fresnel, FresnelMode, Lambert, LobeFlags, Masking,
     MicrofacetDistribution, OrenNayar, RoughDielectric, TorranceSparrow, TransportMode,
@@ -38,7 +40,8 @@ use serde::{Deserialize, Serialize};
 pub struct Coat {
     /// Absolute IOR of the varnish (the medium above the top coat is [`StackDesc::outside_ior`]).
     pub ior: f32,
-    /// RMS micro-facet slope angle of the interface, degrees (0 < m < 90).
+    /// RMS micro-facet slope angle of the interface, degrees (0.01 ≤ m < 90), or exactly 0 for a
+    /// perfectly smooth interface (a Dirac reflection and refraction; the top coat only).
     pub roughness: f32,
     /// Absorption coefficient per unit thickness, per channel (≥ 0).
     pub absorption: Rgb,
@@ -190,9 +193,13 @@ pub(crate) struct Level {
     /// Macro-normal Fresnel for the Course model's `T12`, `T21`.
     pub fresnel: Fresnel,
     /// The interface with transmission (exact Fresnel), for the Reference walk.
-    pub interface: RoughDielectric,
+    pub interface: CoatInterface,
     /// `η = 1` exactly: the interface is invisible and does not deflect light.
     pub index_matched: bool,
+    /// A perfectly smooth interface: its reflection is a Dirac delta (reached only by sampling,
+    /// flagged specular), refraction follows the macro normal exactly, `T = 1 − F`. `top` and
+    /// `interface` then hold a placeholder roughness that is never evaluated as a lobe.
+    pub smooth: bool,
     /// Optical depth `α·d` at normal incidence, per channel.
     pub od: RgbSample,
     /// Whether the absorption code runs for this coat: when `od` is non-zero, or when the
@@ -274,9 +281,12 @@ pub struct LayeredBsdf {
     pub(crate) masking: Masking,
 }
 
+/// Roughness (degrees) of the placeholder micro-facet lobes a smooth coat carries.
+const SMOOTH_PLACEHOLDER: f32 = 0.01;
+
 /// Table entries are measured on a stratified `TABLE_GRID²` grid of directions, each with
 /// `UC_STRATA` lobe choices.
-const TABLE_GRID: usize = 24;
+const TABLE_GRID: usize = 16;
 
 impl LayeredBsdf {
     /// Validates `desc` and builds its runtime tables (a few milliseconds per coat).
@@ -287,14 +297,22 @@ impl LayeredBsdf {
         for c in &desc.coats {
             let eta = c.ior / above;
             above = c.ior;
-            let dist = MicrofacetDistribution::new(desc.distribution, c.roughness)
-                .with_masking(desc.masking);
+            let smooth = c.roughness == 0.0;
+            let dist = MicrofacetDistribution::new(
+                desc.distribution,
+                if smooth { SMOOTH_PLACEHOLDER } else { c.roughness },
+            )
+            .with_masking(desc.masking);
             levels.push(Level {
                 eta,
                 top: TorranceSparrow::new(dist, Fresnel::dielectric(eta, desc.fresnel)),
                 fresnel: Fresnel::dielectric(eta, desc.fresnel),
-                interface: RoughDielectric::new(dist, eta),
+                interface: CoatInterface {
+                    rough: RoughDielectric::new(dist, eta),
+                    smooth,
+                },
                 index_matched: (eta - 1.0).abs() < 1e-6,
+                smooth,
                 od: RgbSample::from(c.absorption) * c.thickness,
                 absorbing: (RgbSample::from(c.absorption) * c.thickness).max_channel() > 0.0,
                 e_top: Table::zero(),
@@ -369,7 +387,7 @@ impl LayeredBsdf {
         }
         if matches!(self.model, Model::Reference(_)) && self.compensation {
             for lv in self.levels.iter_mut() {
-                if lv.interface.energy.is_none() && !lv.index_matched {
+                if lv.interface.rough.energy.is_none() && !lv.index_matched {
                     lv.interface = lv.interface.clone().with_energy_tables();
                 }
             }
@@ -379,6 +397,12 @@ impl LayeredBsdf {
     /// The evaluation model.
     pub fn model(&self) -> Model {
         self.model
+    }
+
+    /// Whether the top coat is perfectly smooth (its reflection is a delta lobe).
+    #[inline]
+    pub fn smooth_top(&self) -> bool {
+        self.levels.first().is_some_and(|l| l.smooth)
     }
 
     /// Number of coats.
@@ -451,11 +475,19 @@ pub fn validate(desc: &StackDesc) -> Result<(), StackError> {
         if !(c.ior >= 1.0001 && c.ior <= 10.0) {
             return bad(format!("coats[{i}].ior"), c.ior, "1.0001 ..= 10");
         }
-        if !(c.roughness >= 0.01 && c.roughness < 90.0) {
+        if c.roughness == 0.0 && i > 0 {
             return bad(
                 format!("coats[{i}].roughness"),
                 c.roughness,
-                "0.01 ..< 90 degrees",
+                "0.01 ..< 90 degrees below the top coat (a perfectly smooth coat, roughness 0, \
+                 must be coats[0])",
+            );
+        }
+        if !(c.roughness == 0.0 || (c.roughness >= 0.01 && c.roughness < 90.0)) {
+            return bad(
+                format!("coats[{i}].roughness"),
+                c.roughness,
+                "0 (smooth) or 0.01 ..< 90 degrees",
             );
         }
         if !(c.thickness >= 0.0 && c.thickness.is_finite()) {
@@ -513,9 +545,14 @@ impl Bxdf for LayeredBsdf {
     fn flags(&self) -> LobeFlags {
         // Every lobe of a stack reflects; the Reference walk is glossy, the analytic models
         // mix glossy coats with the base's spread.
-        match self.model {
+        let body = match self.model {
             Model::Reference(_) => LobeFlags::REFLECTION | LobeFlags::GLOSSY,
             _ => self.base.flags() | LobeFlags::GLOSSY,
+        };
+        if self.smooth_top() {
+            body | LobeFlags::SPECULAR
+        } else {
+            body
         }
     }
     #[inline]

@@ -62,7 +62,20 @@ pub fn sample(
         return None;
     }
     let mut rng = Rng::new(hash_f32s(&[wo.x, wo.y, wo.z, uc, u.x, u.y]));
-    let (wi, weight) = walk_at(stack, p, 0, wo, Some((uc, u)), &mut rng)?;
+    let Walk {
+        wi,
+        weight,
+        specular,
+    } = walk_at(stack, p, 0, wo, Some((uc, u)), &mut rng)?;
+    if specular {
+        // The smooth top coat's mirror reflection: a delta, reported as such (probability 1 of
+        // the walk's own choice, f = weight/|cos θi|).
+        let lobe = Lobe {
+            kind: LobeKind::SpecularReflection,
+            layer: 0,
+        };
+        return BsdfSample::from_eval(wi, weight * (1.0 / wi.z), 1.0, lobe);
+    }
     let pdf = pdf(stack, wo, wi);
     if !(pdf > 0.0) || !weight.is_valid() || wi.z <= 0.0 {
         return None;
@@ -157,7 +170,12 @@ fn eval_at(
             let up_light = -wis.wi;
             let fb = eval_at(stack, p, l + 1, -w, up_light, rng);
             if !fb.is_black() {
-                let wt = power_heuristic(wis.pdf, bottom_pdf(stack, l + 1, -w, up_light));
+                // A delta exit cannot be found by the other strategy: it takes all the weight.
+                let wt = if iface.is_delta() {
+                    1.0
+                } else {
+                    power_heuristic(wis.pdf, bottom_pdf(stack, l + 1, -w, up_light))
+                };
                 acc += beta
                     * fb
                     * (up_light.z.abs() * wt / wis.pdf)
@@ -199,6 +217,16 @@ fn eval_at(
     if f.is_valid() { f } else { RgbSample::ZERO }
 }
 
+/// Where a walk leaves the stack and with what weight.
+struct Walk {
+    /// Exit direction, above the level the walk started at.
+    wi: Vec3,
+    /// Unbiased weight `f cos θi / p` of the walk.
+    weight: RgbSample,
+    /// The walk left by a smooth top interface's mirror reflection at its first event (a delta).
+    specular: bool,
+}
+
 /// Samples the bottom of a level: the base exactly, or a deeper walk. Returns the direction, the
 /// weight and the MIS density ([`bottom_pdf`]).
 fn sample_bottom(
@@ -212,7 +240,7 @@ fn sample_bottom(
         let s = stack.base.sample(wo, rng.uniform(), rng.uniform2())?;
         return Some((s.wi, s.weight, s.pdf));
     }
-    let (wi, weight) = walk_at(stack, p, l, wo, None, rng)?;
+    let Walk { wi, weight, .. } = walk_at(stack, p, l, wo, None, rng)?;
     let pdf = bottom_pdf(stack, l, wo, wi);
     (pdf > 0.0).then_some((wi, weight, pdf))
 }
@@ -226,21 +254,32 @@ fn walk_at(
     wo: Vec3,
     first: Option<(f32, Vec2)>,
     rng: &mut Rng,
-) -> Option<(Vec3, RgbSample)> {
+) -> Option<Walk> {
+    let walk = |wi, weight| {
+        Some(Walk {
+            wi,
+            weight,
+            specular: false,
+        })
+    };
     let Some(lv) = stack.levels.get(l) else {
         let (uc, u) = first.unwrap_or_else(|| (rng.uniform(), rng.uniform2()));
         let s = stack.base.sample(wo, uc, u)?;
-        return Some((s.wi, s.weight));
+        return walk(s.wi, s.weight);
     };
     if lv.index_matched {
-        let (wi, weight) = walk_at(stack, p, l + 1, wo, first, rng)?;
-        return Some((wi, weight * lv.transmit(wo.z) * lv.transmit(wi.z)));
+        let w = walk_at(stack, p, l + 1, wo, first, rng)?;
+        return walk(w.wi, w.weight * lv.transmit(wo.z) * lv.transmit(w.wi.z));
     }
     let iface = &lv.interface;
     let (uc, u) = first.unwrap_or_else(|| (rng.uniform(), rng.uniform2()));
     let s = iface.sample_lobes(wo, uc, u, TransportMode::Radiance, Lobes::All)?;
     if s.wi.z > 0.0 {
-        return Some((s.wi, s.weight));
+        return Some(Walk {
+            wi: s.wi,
+            weight: s.weight,
+            specular: iface.is_delta(),
+        });
     }
     let mut beta = s.weight;
     let mut w = s.wi;
@@ -268,7 +307,7 @@ fn walk_at(
         )?;
         beta *= s.weight;
         if s.wi.z > 0.0 {
-            return Some((s.wi, beta));
+            return walk(s.wi, beta);
         }
         w = s.wi;
         if beta.is_black() {
