@@ -22,15 +22,16 @@
 //!    lobe built without detailed balance (`InterfaceEnergy::new(.., 1.0)`, so
 //!    `c[above][below] = c[below][above]`) breaks the generalised reciprocity. Transmission pairs
 //!    whose half vector is within `|cos θh| < 1e-3` of the surface plane are left out and counted
-//!    (6–14 of the 20 000 per interface): there single scattering itself is not adjoint in f32, a bug
-//!    in src/ pinned by `value_is_adjoint_at_a_half_vector_near_the_horizon` (fails until fixed).
+//!    (6–14 of the 20 000 per interface): there `D` used to return 0 in one argument order only
+//!    (sin² θh rounding to 1 in f32); the fix is pinned by
+//!    `value_is_adjoint_at_a_half_vector_near_the_horizon`.
 //! 3. **Energy**: `compensated_interface_conserves_energy` — importance-mode mean weight `R + T`
 //!    = 1 within `0.005 + 3σ` at θo = 0, 30, 60, 80, 89° on both sides (50 000 draws each,
-//!    500 000 full; 90 checks). **Fails with the current src/** (worst 0.9799 ± 0.0009, Blinn
-//!    45°, η 2.4, θo 91°): the lobe returns `1 − E_s(μ)` of single-scattering tables measured by
-//!    `with_energy_tables` with 16² · 4 = 1 024 samples per entry, whose noise reaches 1.7 % at
-//!    grazing for m 45°; the failure message repeats the measurement with 64² · 4 samples per
-//!    entry (then the worst is 0.43 %, and the test passes). `hemispherical_transmittance_is_reciprocal`
+//!    500 000 full; 90 checks). The lobe returns `1 − E_s(μ)` of single-scattering tables measured
+//!    by `with_energy_tables` with 32² · 4 = 4 096 samples per entry (worst measured here 1.00797 ±
+//!    0.0017, Blinn 45°, η 1.5, θo 91°); with 1 024 samples per entry it failed (0.9799 ± 0.0009,
+//!    Blinn 45°, η 2.4, θo 91°). A failure message repeats the measurement with 64² · 4 samples
+//!    per entry, to tell table noise from a real loss. `hemispherical_transmittance_is_reciprocal`
 //!    — the hemispherical transmittances (cosine-distributed `wo`, 100 000 draws per side,
 //!    1 000 000 full) obey `t̄(above) = η² t̄(below)` within 3σ (9 checks: per-check false alarm
 //!    0.27 %, family-wise 2.4 %; the seeds are fixed, so CI is repeatable). The old
@@ -286,15 +287,13 @@ fn reciprocity_and_adjoint_of_the_full_value() {
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
-/// KNOWN BUG in src/ (this test fails until it is fixed): `MicrofacetDistribution::d` returns 0
-/// when `sin²θh`, computed in f32 from `h.x² + h.y²`, rounds to ≥ 1 — for `|cos θh|` below about
-/// 2.4e-4 — although Blinn at m = 45° (exponent ≈ 0) and GGX have `D > 0` at the horizon. The two
-/// argument orders of a transmission pair compute `h` with different roundings, so one order gets
-/// `D = 1/π` and the other 0: `f_rad(wo, wi) = 8.38e-3` but `f_imp(wi, wo) = 0` for the pair
-/// below (found by `reciprocity_and_adjoint_of_the_full_value`, which now leaves pairs with
-/// `|cos θh| < 1e-3` out). The affected set has negligible measure; the fix is to take `cos θh`
-/// from `h.z` there (`ln cos = ln h.z` for Blinn when `sin²θ ≥ 0.5`, as Beckmann and GGX already
-/// do for `cos²`) instead of returning 0.
+/// `MicrofacetDistribution::d` used to return 0 when `sin²θh`, computed in f32 from
+/// `h.x² + h.y²`, rounds to ≥ 1 — for `|cos θh|` below about 2.4e-4 — although Blinn at m = 45°
+/// (exponent ≈ 0) and GGX have `D > 0` at the horizon. The two argument orders of a transmission
+/// pair compute `h` with different roundings, so one order got `D = 1/π` and the other 0:
+/// `f_rad(wo, wi) = 8.38e-3` but `f_imp(wi, wo) = 0` for the pair below (found by
+/// `reciprocity_and_adjoint_of_the_full_value`). Fixed by taking `ln cos θh = ln h.z` for Blinn
+/// when `sin²θ ≥ 0.5`; this pins it.
 #[test]
 fn value_is_adjoint_at_a_half_vector_near_the_horizon() {
     let plain = RoughDielectric::new(
@@ -346,7 +345,7 @@ fn the_old_compensation_breaks_detailed_balance() {
     assert!((ss_a - eta2 * ss_b).abs() < 3e-3 * ss_a, "{ss_a} {ss_b}");
 }
 
-/// Fails with the current src/: see [`run_energy`]'s message.
+/// Item 3 (module docs).
 #[test]
 fn compensated_interface_conserves_energy() {
     run_energy(N_MEAN);

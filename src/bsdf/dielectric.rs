@@ -66,7 +66,12 @@ impl RoughDielectric {
     /// no lobe.
     pub fn with_energy_tables(mut self) -> Self {
         let d = self.distribution;
-        let key = (d.kind(), d.masking(), d.alpha().to_bits(), self.eta.to_bits());
+        let key = (
+            d.kind(),
+            d.masking(),
+            d.alpha().to_bits(),
+            self.eta.to_bits(),
+        );
         self.energy = ENERGY.get_or_build(key, || self.build_energy());
         self
     }

@@ -29,10 +29,10 @@
 use super::interface::CoatInterface;
 use super::{LayeredBsdf, Level};
 use crate::bsdf::dielectric::Lobes;
+use crate::bsdf::memo::Memo;
 use crate::bsdf::table::{Table, for_strata};
 use crate::bsdf::{Bsdf, Bxdf, TransportMode};
 use crate::sampler::{Rng, hash_words};
-use crate::bsdf::memo::Memo;
 use crate::spectrum::RgbSample;
 use glam::{Vec2, Vec3};
 use std::sync::Arc;
@@ -188,10 +188,10 @@ impl Matrix {
     /// `diag(left) · self · diag(right)`.
     fn scale(&self, left: &[RgbSample], right: &[RgbSample]) -> Matrix {
         let mut out = self.clone();
-        for c in 0..3 {
-            for i in 0..BINS {
-                for j in 0..BINS {
-                    out.0[c][i * BINS + j] *= f64::from(left[i][c] * right[j][c]);
+        for (c, m) in out.0.iter_mut().enumerate() {
+            for (row, l) in m.chunks_exact_mut(BINS).zip(left) {
+                for (v, r) in row.iter_mut().zip(right) {
+                    *v *= f64::from(l[c] * r[c]);
                 }
             }
         }
@@ -278,11 +278,11 @@ fn kernels(
         .collect();
     let mut same = Matrix::zero();
     let mut cross = Matrix::zero();
-    for (j, col) in cols.iter().enumerate() {
-        for i in 0..BINS {
+    for (j, [col_same, col_cross]) in cols.iter().enumerate() {
+        for (i, (a, b)) in col_same.iter().zip(col_cross).enumerate() {
             for c in 0..3 {
-                same.0[c][i * BINS + j] = f64::from(col[0][i][c]);
-                cross.0[c][i * BINS + j] = f64::from(col[1][i][c]);
+                same.0[c][i * BINS + j] = f64::from(a[c]);
+                cross.0[c][i * BINS + j] = f64::from(b[c]);
             }
         }
     }
@@ -507,7 +507,11 @@ static FIRST: Memo<(OpsKey, u32, usize), Arc<FirstStep>> = Memo::new(16384);
 /// would put ~0.5 % noise into each node's albedo near grazing).
 fn first_step(iface: &CoatInterface, inside: Layout, mu: f32, grid: usize) -> Arc<FirstStep> {
     let grid = grid.max(FIRST_GRID);
-    let key = (OpsKey::new(iface, Layout::UNIFORM, inside, false), mu.to_bits(), grid);
+    let key = (
+        OpsKey::new(iface, Layout::UNIFORM, inside, false),
+        mu.to_bits(),
+        grid,
+    );
     FIRST.get_or_build(key, || {
         let wo = Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
         let n = (grid * grid * crate::bsdf::table::UC_STRATA) as f32;
@@ -515,15 +519,19 @@ fn first_step(iface: &CoatInterface, inside: Layout, mu: f32, grid: usize) -> Ar
             reflect: 0.0,
             into: vec![0.0; BINS],
         };
-        for_strata(grid, hash_words(&[0xadd2, u64::from(mu.to_bits())]), |uc, u| {
-            for (wi, w) in sample_interface(iface, wo, uc, u).into_iter().flatten() {
-                if wi.z > 0.0 {
-                    step.reflect += w[0] / n;
-                } else {
-                    step.into[inside.bin(wi.z.abs())] += w[0] / n;
+        for_strata(
+            grid,
+            hash_words(&[0xadd2, u64::from(mu.to_bits())]),
+            |uc, u| {
+                for (wi, w) in sample_interface(iface, wo, uc, u).into_iter().flatten() {
+                    if wi.z > 0.0 {
+                        step.reflect += w[0] / n;
+                    } else {
+                        step.into[inside.bin(wi.z.abs())] += w[0] / n;
+                    }
                 }
-            }
-        });
+            },
+        );
         Arc::new(step)
     })
 }
@@ -550,12 +558,15 @@ fn row_series(v: [Vec<f64>; 3], r: &Matrix, x: &Matrix) -> [Vec<f64>; 3] {
         // Row vector times matrix: entry j of v·M is Σ_i v_i M[i][j], with M[to][from]: apply M
         // from the right means the path takes M *before* the steps already in v.
         term = apply(&apply(&term, r), x);
-        let (t, a) = term.iter().zip(&acc).fold((0.0f64, 0.0f64), |(t, a), (tc, ac)| {
-            (
-                t.max(tc.iter().fold(0.0, |m, &x| m.max(x.abs()))),
-                a.max(ac.iter().fold(0.0, |m, &x| m.max(x.abs()))),
-            )
-        });
+        let (t, a) = term
+            .iter()
+            .zip(&acc)
+            .fold((0.0f64, 0.0f64), |(t, a), (tc, ac)| {
+                (
+                    t.max(tc.iter().fold(0.0, |m, &x| m.max(x.abs()))),
+                    a.max(ac.iter().fold(0.0, |m, &x| m.max(x.abs()))),
+                )
+            });
         for c in 0..3 {
             for (a, t) in acc[c].iter_mut().zip(&term[c]) {
                 *a += t;
@@ -689,23 +700,31 @@ impl Solution<'_> {
         let wo = Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
         let mut rng = Rng::new(hash_words(&[0xadd3, u64::from(mu.to_bits())]));
         let mut sum = RgbSample::ZERO;
-        for_strata(grid, hash_words(&[0xadd2, u64::from(mu.to_bits())]), |uc, u| {
-            for (wi, w) in sample_interface(iface, wo, uc, u).into_iter().flatten() {
-                if wi.z > 0.0 {
-                    sum += w;
-                    continue;
+        for_strata(
+            grid,
+            hash_words(&[0xadd2, u64::from(mu.to_bits())]),
+            |uc, u| {
+                for (wi, w) in sample_interface(iface, wo, uc, u).into_iter().flatten() {
+                    if wi.z > 0.0 {
+                        sum += w;
+                        continue;
+                    }
+                    let Some(b) = base.sample_mode(
+                        -wi,
+                        rng.uniform(),
+                        rng.uniform2(),
+                        TransportMode::Radiance,
+                    ) else {
+                        continue;
+                    };
+                    let legs = top.transmit(wi.z) * top.transmit(b.wi.z);
+                    let k = self.inside.bin(b.wi.z);
+                    let out = transmit.at(b.wi.z)[0];
+                    let value = RgbSample(std::array::from_fn(|c| out + after[c][k] as f32));
+                    sum += w * b.weight * legs * value;
                 }
-                let Some(b) = base.sample_mode(-wi, rng.uniform(), rng.uniform2(), TransportMode::Radiance)
-                else {
-                    continue;
-                };
-                let legs = top.transmit(wi.z) * top.transmit(b.wi.z);
-                let k = self.inside.bin(b.wi.z);
-                let out = transmit.at(b.wi.z)[0];
-                let value = RgbSample(std::array::from_fn(|c| out + after[c][k] as f32));
-                sum += w * b.weight * legs * value;
-            }
-        });
+            },
+        );
         sum / (grid * grid * crate::bsdf::table::UC_STRATA) as f32
     }
 }
@@ -721,13 +740,17 @@ fn transmittance_from_below(iface: &CoatInterface) -> Arc<Table> {
             let wo = Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, -mu);
             let mut sum = 0.0f32;
             let grid = FIRST_GRID;
-            for_strata(grid, hash_words(&[0xadd4, u64::from(mu.to_bits())]), |uc, u| {
-                if let Some(s) =
-                    iface.sample_lobes(wo, uc, u, TransportMode::Radiance, Lobes::Transmission)
-                {
-                    sum += s.weight[0];
-                }
-            });
+            for_strata(
+                grid,
+                hash_words(&[0xadd4, u64::from(mu.to_bits())]),
+                |uc, u| {
+                    if let Some(s) =
+                        iface.sample_lobes(wo, uc, u, TransportMode::Radiance, Lobes::Transmission)
+                    {
+                        sum += s.weight[0];
+                    }
+                },
+            );
             RgbSample::splat(sum / (grid * grid * crate::bsdf::table::UC_STRATA) as f32)
         }))
     })

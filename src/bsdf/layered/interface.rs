@@ -150,7 +150,10 @@ mod tests {
 
     fn smooth(eta: f32) -> CoatInterface {
         CoatInterface {
-            rough: RoughDielectric::new(MicrofacetDistribution::new(Distribution::Blinn, 0.01), eta),
+            rough: RoughDielectric::new(
+                MicrofacetDistribution::new(Distribution::Blinn, 0.01),
+                eta,
+            ),
             smooth: true,
         }
     }
@@ -161,18 +164,30 @@ mod tests {
         let wo = spherical_direction(0.7, 0.2);
         let f = fresnel::dielectric(wo.z, 1.5);
         let m = TransportMode::Importance;
-        let r = i.sample_lobes(wo, 0.5, Vec2::ZERO, m, Lobes::Reflection).unwrap();
+        let r = i
+            .sample_lobes(wo, 0.5, Vec2::ZERO, m, Lobes::Reflection)
+            .unwrap();
         assert!((r.weight[0] - f).abs() < 1e-6 && r.wi.z > 0.0);
-        let t = i.sample_lobes(wo, 0.5, Vec2::ZERO, m, Lobes::Transmission).unwrap();
+        let t = i
+            .sample_lobes(wo, 0.5, Vec2::ZERO, m, Lobes::Transmission)
+            .unwrap();
         assert!((t.weight[0] - (1.0 - f)).abs() < 1e-6 && t.wi.z < 0.0);
         let tr = i
-            .sample_lobes(wo, 0.5, Vec2::ZERO, TransportMode::Radiance, Lobes::Transmission)
+            .sample_lobes(
+                wo,
+                0.5,
+                Vec2::ZERO,
+                TransportMode::Radiance,
+                Lobes::Transmission,
+            )
             .unwrap();
         assert!((tr.weight[0] - (1.0 - f) / 2.25).abs() < 1e-6);
         // All lobes: reflection with probability F, each weight 1 in importance mode.
         let a = i.sample_lobes(wo, 0.0, Vec2::ZERO, m, Lobes::All).unwrap();
         assert!(a.wi.z > 0.0 && (a.weight[0] - 1.0).abs() < 1e-5);
-        let b = i.sample_lobes(wo, 0.999, Vec2::ZERO, m, Lobes::All).unwrap();
+        let b = i
+            .sample_lobes(wo, 0.999, Vec2::ZERO, m, Lobes::All)
+            .unwrap();
         assert!(b.wi.z < 0.0 && (b.weight[0] - 1.0).abs() < 1e-5);
         assert_eq!(i.value(wo, b.wi, m), 0.0);
         assert_eq!(i.pdf_lobes(wo, b.wi, Lobes::All), 0.0);

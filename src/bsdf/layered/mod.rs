@@ -20,12 +20,11 @@
 pub mod adding;
 pub mod calibrate;
 pub mod corrected;
-pub mod interface;
 pub mod course;
+pub mod interface;
 pub mod reference;
 
 use super::table::Table;
-use interface::CoatInterface;
 use super::{
     Bsdf, BsdfSample, Bxdf, Distribution, Fresnel, FresnelMode, Lambert, LobeFlags, Masking,
     MicrofacetDistribution, OrenNayar, RoughDielectric, TorranceSparrow, TransportMode,
@@ -33,6 +32,7 @@ use super::{
 use crate::color::Rgb;
 use crate::spectrum::RgbSample;
 use glam::{Vec2, Vec3};
+use interface::CoatInterface;
 use serde::{Deserialize, Serialize};
 
 /// One coat of a stack: a rough dielectric interface and the varnish below it.
@@ -300,7 +300,11 @@ impl LayeredBsdf {
             let smooth = c.roughness == 0.0;
             let dist = MicrofacetDistribution::new(
                 desc.distribution,
-                if smooth { SMOOTH_PLACEHOLDER } else { c.roughness },
+                if smooth {
+                    SMOOTH_PLACEHOLDER
+                } else {
+                    c.roughness
+                },
             )
             .with_masking(desc.masking);
             levels.push(Level {
