@@ -29,7 +29,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 /// Sampling grid per node for the body's transfer and the target (`GRID² · UC_STRATA` samples).
-const GRID: usize = 16;
+const GRID: usize = 20;
 
 /// The calibration is solved on every [`STRIDE`]-th table entry (22 nodes at `cos θ = k/21`) and
 /// interpolated linearly between them, which the table's own interpolation then reproduces
@@ -154,7 +154,10 @@ mod tests {
 
     #[test]
     fn calibrated_albedo_meets_the_adding_target() {
-        // A rough tinted coat over a mirror: the uncalibrated body lets too much out.
+        // A rough tinted coat over a mirror: the uncalibrated body lets 30 % too much out. The
+        // calibration is exact at its 22 nodes up to the noise of its transfer rows; between
+        // nodes (a piecewise-linear `c`) this stack departs by up to 2 % (measured 1.7 % at θo 65°
+        // and 72°), the bound for Corrected against the walk: asserted here with 4σ.
         let desc = StackDesc::new(
             vec![Coat {
                 ior: 1.5,
@@ -169,12 +172,14 @@ mod tests {
         );
         let stack = LayeredBsdf::new(&desc).unwrap();
         let target = adding::albedo(&stack);
-        for th in [0.0f32, 45.0, 70.0] {
+        let mut plain = stack.clone();
+        plain.calibration = None;
+        for th in [0.0f32, 45.0, 65.0, 72.0] {
             let wo = direction_deg(th, 0.0);
             let e = albedo_by_sampling(&stack, wo, 100_000, 3);
             let t = target.at(wo.z);
             for ch in 0..3 {
-                let tol = 4.0 * e.std_error[ch] + 0.01 * t[ch];
+                let tol = 4.0 * e.std_error[ch] + 0.02 * t[ch];
                 assert!(
                     (e.mean[ch] - t[ch]).abs() < tol,
                     "{th} {ch}: {:?} vs {:?}",
@@ -183,5 +188,14 @@ mod tests {
                 );
             }
         }
+        // Without the calibration the same check fails by far.
+        let e = albedo_by_sampling(&plain, direction_deg(45.0, 0.0), 100_000, 3);
+        let t = target.at(direction_deg(45.0, 0.0).z);
+        assert!(
+            e.mean[2] > 1.1 * t[2],
+            "uncalibrated {:?} vs {:?}",
+            e.mean,
+            t
+        );
     }
 }
