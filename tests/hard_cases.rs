@@ -1649,20 +1649,30 @@ fn stack_desc() -> impl Strategy<Value = StackDesc> {
         distribution(),
         prop_oneof![Just(None), Just(Some(true)), Just(Some(false))],
         any::<bool>(),
+        (any::<bool>(), any::<bool>()),
     )
         .prop_map(
-            |(coats, base, model, fresnel, distribution, t_term, compensation)| StackDesc {
-                coats,
-                base,
-                model,
-                fresnel,
-                distribution,
-                // The candidate directions of these checks are the V-cavity sampler's; Smith
-                // masking has its own tests (tests/chi_square.rs, tests/dielectric.rs).
-                masking: lapidary::bsdf::Masking::VCavity,
-                outside_ior: 1.0,
-                t_term,
-                compensation,
+            |(mut coats, base, model, fresnel, distribution, t_term, compensation, smooth_top)| {
+                StackDesc {
+                    // The top coat may be perfectly smooth (a delta reflection).
+                    coats: {
+                        if smooth_top.0 {
+                            coats[0].roughness = 0.0;
+                        }
+                        coats
+                    },
+                    base,
+                    model,
+                    fresnel,
+                    distribution,
+                    // The candidate directions of these checks are the V-cavity sampler's; Smith
+                    // masking has its own tests (tests/chi_square.rs, tests/dielectric.rs).
+                    masking: lapidary::bsdf::Masking::VCavity,
+                    outside_ior: 1.0,
+                    t_term,
+                    compensation,
+                    calibration: smooth_top.1,
+                }
             },
         )
 }

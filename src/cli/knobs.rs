@@ -32,6 +32,9 @@ pub struct KnobArgs {
     /// Multiple-scattering compensation of every material: on or off.
     #[arg(long, value_parser = switch_arg)]
     compensation: Option<bool>,
+    /// The Corrected model's albedo calibration of every material: on or off.
+    #[arg(long, value_parser = switch_arg)]
+    calibration: Option<bool>,
     /// The course's `t` term for every coated material: on or off (same as
     /// `--effect t-term=…`).
     #[arg(long, value_parser = |s: &str| alias_arg(Effect::TTerm, s))]
@@ -59,6 +62,7 @@ impl KnobArgs {
             distribution: self.distribution,
             masking: self.masking,
             compensation: self.compensation,
+            calibration: self.calibration,
             effects: vec![],
         };
         let aliases = [self.t_term, self.absorption, self.bump];

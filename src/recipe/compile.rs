@@ -219,6 +219,7 @@ impl Compiler<'_> {
             distribution: desc.distribution,
             masking: desc.masking,
             compensation: desc.compensation,
+            calibration: desc.calibration,
             effects: vec![],
         };
         for (key, value) in [

@@ -8,7 +8,8 @@
 //!     // optional: model: Corrected | Course | Reference(samples: 4, max_depth: 256),
 //!     //           fresnel: Exact | Schlick | Lazanyi | Table,
 //!     //           distribution: Blinn | Beckmann | Ggx, masking: VCavity | Smith | SmithSeparable,
-//!     //           outside_ior: 1.33, t_term: true/false, compensation: true/false
+//!     //           outside_ior: 1.33, t_term: true/false, compensation: true/false,
+//!     //           calibration: true/false
 //! )
 //! ```
 
@@ -223,6 +224,9 @@ pub struct MaterialDesc {
     /// Multiple-scattering compensation (default true).
     #[serde(default = "yes")]
     pub compensation: bool,
+    /// The Corrected model's albedo calibration (default true).
+    #[serde(default = "yes")]
+    pub calibration: bool,
 }
 
 impl MaterialDesc {
@@ -309,6 +313,7 @@ impl MaterialDesc {
             outside_ior: self.outside_ior,
             t_term: self.t_term,
             compensation: self.compensation,
+            calibration: self.calibration,
         })
     }
 }

@@ -466,6 +466,9 @@ pub struct AccuracyDesc {
     /// Multiple-scattering compensation on or off for every material.
     #[serde(default)]
     pub compensation: Option<bool>,
+    /// The Corrected model's albedo calibration on or off for every material.
+    #[serde(default)]
+    pub calibration: Option<bool>,
     /// The course's `t` term on or off for every coated material.
     #[serde(default)]
     pub t_term: Option<bool>,

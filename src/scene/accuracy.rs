@@ -64,6 +64,9 @@ pub struct Accuracy {
     /// (and the Reference walk's interfaces) on or off (`None`: each material's own; it adds
     /// ~2 % to gold at mid angles against an uncompensated peer, docs/parity.md).
     pub compensation: Option<bool>,
+    /// The Corrected model's albedo calibration to the adding solution on or off (`None`: each
+    /// material's own; docs/materials.md measures what it buys).
+    pub calibration: Option<bool>,
     /// Effects forced on (`true`) or off, in the order they were set.
     pub effects: Vec<(Effect, bool)>,
 }
@@ -107,6 +110,7 @@ impl Accuracy {
                 )
             }
             "compensation" => self.compensation = Some(parse_switch(key, value)?),
+            "calibration" => self.calibration = Some(parse_switch(key, value)?),
             "masking" => {
                 self.masking = Some(
                     value
@@ -144,6 +148,9 @@ impl Accuracy {
         if let Some(c) = self.compensation {
             stack.compensation = c;
         }
+        if let Some(c) = self.calibration {
+            stack.calibration = c;
+        }
         if let Some(t) = self.forced(Effect::TTerm) {
             stack.t_term = Some(t);
         }
@@ -156,12 +163,13 @@ impl Accuracy {
 }
 
 /// Every knob key [`Knobs::set`] accepts (the effect names of [`Effect::name`] work too).
-pub const KNOB_KEYS: [&str; 14] = [
+pub const KNOB_KEYS: [&str; 15] = [
     "model",
     "fresnel",
     "distribution",
     "masking",
     "compensation",
+    "calibration",
     "t-term",
     "absorption",
     "bump",
@@ -224,6 +232,9 @@ impl fmt::Display for Accuracy {
         }
         if let Some(c) = self.compensation {
             parts.push(format!("compensation={}", if c { "on" } else { "off" }));
+        }
+        if let Some(c) = self.calibration {
+            parts.push(format!("calibration={}", if c { "on" } else { "off" }));
         }
         for (e, on) in &self.effects {
             let name = if *e == Effect::FacetBump {
@@ -474,16 +485,17 @@ mod tests {
                 roughness: 10.0,
             },
         );
-        let k: Knobs = "distribution=ggx,masking=smith-separable,compensation=off"
+        let k: Knobs = "distribution=ggx,masking=smith-separable,compensation=off,calibration=off"
             .parse()
             .unwrap();
         k.accuracy.apply_to(&mut s);
         assert_eq!(s.distribution, Distribution::Ggx);
         assert_eq!(s.masking, Masking::SmithSeparable);
         assert!(!s.compensation);
+        assert!(!s.calibration);
         assert_eq!(
             k.accuracy.to_string(),
-            "distribution=ggx,masking=smith-separable,compensation=off"
+            "distribution=ggx,masking=smith-separable,compensation=off,calibration=off"
         );
         let e = "masking=torrance".parse::<Knobs>().unwrap_err().0;
         assert!(e.contains("v-cavity, smith, smith-separable"), "{e}");

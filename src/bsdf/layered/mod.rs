@@ -144,6 +144,9 @@ pub struct StackDesc {
     /// Multiple-scattering energy compensation (Turquin 2019) of a conductor base (Corrected and
     /// Reference) and of the coats' interfaces (Reference). The Course model never uses it.
     pub compensation: bool,
+    /// The Corrected model's albedo calibration to the adding solution ([`calibrate`]); on by
+    /// default, off to measure what it buys (`tradeoff` knob `calibration`).
+    pub calibration: bool,
 }
 
 impl StackDesc {
@@ -159,6 +162,7 @@ impl StackDesc {
             outside_ior: 1.0,
             t_term: None,
             compensation: true,
+            calibration: true,
         }
     }
     /// The same stack under another model.
@@ -274,8 +278,10 @@ pub struct LayeredBsdf {
     pub(crate) t_term: Option<bool>,
     pub(crate) compensation: bool,
     /// The Corrected model's albedo calibration `c(μ)` of the outermost body ([`calibrate`]);
-    /// `None` until a Corrected stack without the `t` term is prepared.
+    /// `None` until a Corrected stack without the `t` term is prepared, or when switched off.
     pub(crate) calibration: Option<std::sync::Arc<Table>>,
+    /// Whether the Corrected model is calibrated ([`StackDesc::calibration`]).
+    pub(crate) calibrate: bool,
     pub(crate) fresnel: FresnelMode,
     pub(crate) distribution: Distribution,
     pub(crate) masking: Masking,
@@ -366,6 +372,7 @@ impl LayeredBsdf {
             t_term,
             compensation: desc.compensation,
             calibration: None,
+            calibrate: desc.calibration,
             fresnel: desc.fresnel,
             distribution: desc.distribution,
             masking: desc.masking,
@@ -383,6 +390,7 @@ impl LayeredBsdf {
     /// Reference walk.
     fn prepare_model(&mut self) {
         if self.model == Model::Corrected
+            && self.calibrate
             && !self.t_term()
             && self.calibration.is_none()
             && !self.levels.is_empty()
@@ -428,7 +436,8 @@ impl LayeredBsdf {
             Model::Reference(p) => format!("Reference({} walks, depth {})", p.samples, p.max_depth),
         };
         format!(
-            "model {model}, fresnel {:?}, distribution {:?}{}, t term {}, compensation {}",
+            "model {model}, fresnel {:?}, distribution {:?}{}, t term {}, compensation {}, \
+             calibration {}",
             self.fresnel,
             self.distribution,
             match self.masking {
@@ -436,7 +445,12 @@ impl LayeredBsdf {
                 m => format!(", masking {m:?}"),
             },
             if self.t_term() { "on" } else { "off" },
-            if self.compensation { "on" } else { "off" }
+            if self.compensation { "on" } else { "off" },
+            if self.calibration.is_some() {
+                "on"
+            } else {
+                "off"
+            }
         )
     }
 
