@@ -75,7 +75,10 @@ CASES = (
     ("rough-plastic", "rough-plastic"),
     ("rough-plastic-vcavity", "rough-plastic"),
     ("rough-plastic-reference", "rough-plastic"),
+    ("rough-plastic-nocomp", "rough-plastic"),
+    ("rough-plastic-reference-nocomp", "rough-plastic"),
     ("smooth-plastic", "smooth-plastic"),
+    ("smooth-plastic-reference", "smooth-plastic"),
 )
 
 
