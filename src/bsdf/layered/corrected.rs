@@ -57,11 +57,15 @@ pub(super) fn eval_parts(
     if wo.z <= 0.0 || wi.z <= 0.0 {
         return (RgbSample::ZERO, RgbSample::ZERO);
     }
-    // A smooth coat's reflection is a delta: never reached by evaluation.
+    // A smooth coat's reflection is a delta: never reached by evaluation. A compensated rough
+    // coat reflects its multiple-scattering lobe's share too (`Level::top_energy`).
     let top = if lv.smooth {
         RgbSample::ZERO
     } else {
-        lv.top.eval(wo, wi)
+        let ms = lv.top_energy.as_ref().map_or(0.0, |e| {
+            e.value(wo, wi, crate::bsdf::TransportMode::Radiance)
+        });
+        lv.top.eval(wo, wi) + RgbSample::splat(ms)
     };
     let Some(wo_in) = refract_macro(wo, lv.eta) else {
         return (top, RgbSample::ZERO);
@@ -137,7 +141,9 @@ pub(super) fn lobe_weights(
                 _ => 1.0,
             };
             w[1] = t * c2 * (a - q).luminance().max(0.0);
-            w[2] = t * c2 * (q * lv.multi_albedo).luminance().max(0.0);
+            // The cosine lobe also carries the top interface's multiple-scattering reflection.
+            let ms = lv.top_energy.as_ref().map_or(0.0, |e| e.split(wo).0);
+            w[2] = t * c2 * (q * lv.multi_albedo).luminance().max(0.0) + ms;
         } else {
             w[1] = t * a.luminance().max(0.0);
         }

@@ -219,6 +219,9 @@ pub(crate) struct Level {
     pub multi_scale: RgbSample,
     /// Fraction of `q` that leaves after the inner bounces: `ρ̄ (1 − r_int) / (1 − ρ̄ r_int)`.
     pub multi_albedo: RgbSample,
+    /// The interface's multiple-scattering lobe, when a Corrected stack compensates: its
+    /// reflection part joins the top lobe, as in the Reference walk ([`corrected`]).
+    pub top_energy: Option<std::sync::Arc<crate::bsdf::interface_energy::InterfaceEnergy>>,
 }
 
 impl Level {
@@ -330,6 +333,7 @@ impl LayeredBsdf {
                 trapped: Table::zero(),
                 multi_scale: RgbSample::ZERO,
                 multi_albedo: RgbSample::ZERO,
+                top_energy: None,
             });
         }
         let base = match desc.base {
@@ -389,6 +393,13 @@ impl LayeredBsdf {
     /// reflection is then measured as it is), the interfaces' energy tables for a compensated
     /// Reference walk.
     fn prepare_model(&mut self) {
+        if self.model == Model::Corrected && self.compensation {
+            for lv in self.levels.iter_mut() {
+                if lv.top_energy.is_none() && !lv.smooth && !lv.index_matched {
+                    lv.top_energy = lv.interface.clone().with_energy_tables().rough.energy;
+                }
+            }
+        }
         if self.model == Model::Corrected
             && self.calibrate
             && !self.t_term()
