@@ -68,13 +68,15 @@ pub fn sample(
         specular,
     } = walk_at(stack, p, 0, wo, Some((uc, u)), &mut rng)?;
     if specular {
-        // The smooth top coat's mirror reflection: a delta, reported as such (probability 1 of
-        // the walk's own choice, f = weight/|cos θi|).
+        // The smooth top coat's mirror reflection: a delta, chosen with probability F(μo) by the
+        // walk's first event; reported in the delta convention (pdf = that probability,
+        // f = weight · pdf / |cos θi|, i.e. F/|cos θi|).
         let lobe = Lobe {
             kind: LobeKind::SpecularReflection,
             layer: 0,
         };
-        return BsdfSample::from_eval(wi, weight * (1.0 / wi.z), 1.0, lobe);
+        let p = crate::bsdf::fresnel::dielectric(wo.z, stack.levels[0].eta);
+        return BsdfSample::from_eval(wi, weight * (p / wi.z), p, lobe);
     }
     let pdf = pdf(stack, wo, wi);
     if !(pdf > 0.0) || !weight.is_valid() || wi.z <= 0.0 {
