@@ -43,8 +43,6 @@
 //! --nocapture` prints every table. Heavy (10× the samples, θo also 45/70/85° — 252 comparisons,
 //! Šidák 1.6 % —, 1 000 000 samples per chi-square, 96×96 at 256 spp; ~30 s):
 //! `cargo test --release --test smooth_coat -- --ignored --nocapture heavy`.
-//! `reference_specular_sample_reports_its_probability` is ignored because it fails (a bug in src,
-//! see its doc comment): `cargo test --release --test smooth_coat -- --ignored reference_specular`.
 
 #[path = "smooth_coat/chi.rs"]
 mod chi;
@@ -295,15 +293,11 @@ fn delta_is_sampled_and_never_evaluated() {
     assert!(!bookkeeping(&b, &rough, wo, 100, 1).is_empty());
 }
 
-/// **Fails today (bug in src/bsdf/layered/reference.rs, `sample`):** the Reference walk reports its
-/// specular sample with `pdf = 1` and `f = weight/cos = 1/cos θi`, where the contract of
-/// `BsdfSample` (and of the Corrected/Course delta) is `pdf` = the discrete probability of the
-/// choice (`F(μo)`: the walk reflects when `uc < F`) and `f = F/cos θi`. `weight` (1) and the
-/// rendered result are right — the integrator ignores `pdf` after a specular event — but `f` and
-/// `pdf` each claim the delta carries all the flux. Run with
-/// `cargo test --release --test smooth_coat -- --ignored reference_specular`.
+/// The Reference walk reports a smooth coat's specular sample as the `BsdfSample` contract (and
+/// the Corrected/Course delta) do: `pdf` is the discrete probability of the choice (`F(μo)`: the
+/// walk reflects when `uc < F`) and `f = F/cos θi`, so `f·cos/pdf` is the weight 1. Before the fix
+/// it reported `pdf = 1` and `f = 1/cos θi` (the rendered result was right either way).
 #[test]
-#[ignore = "fails: the Reference walk reports a smooth coat's delta with pdf 1 and f = 1/cos"]
 fn reference_specular_sample_reports_its_probability() {
     let r = build(&[coat(1.5, 0.0, [0.0; 3])], lambert(0.8), reference(), true);
     let wo = direction_deg(60.0, 0.0);
