@@ -38,6 +38,7 @@ pub mod color;
 pub mod geometry;
 pub mod image;
 pub mod light;
+pub mod medium;
 pub mod recipe;
 pub mod render;
 pub mod sampler;

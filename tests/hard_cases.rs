@@ -308,10 +308,7 @@ fn check_sample(b: &impl Bxdf, kind: Kind, wo: Vec3, uc: f32, u: Vec2) -> Check 
         // A delta (a smooth top coat's mirror reflection): its pdf is the probability of the
         // choice and `f` carries F/cos; neither `pdf` nor `eval` can see it (their values at the
         // mirror direction are the other lobes' alone, and must stay finite).
-        ensure!(
-            s.pdf <= 1.0 + 1e-6,
-            "{at}: a delta's pdf is a probability"
-        );
+        ensure!(s.pdf <= 1.0 + 1e-6, "{at}: a delta's pdf is a probability");
         let (p, f) = (b.pdf(wo, s.wi), b.eval(wo, s.wi));
         ensure!(
             p.is_finite() && p >= 0.0 && f.is_valid(),

@@ -183,7 +183,7 @@ fn info_prints_materials_map_statistics_stage_and_effects() {
         "on   facet-bump               surface.over.bump = Cone { half_angle: 25.0 }",
         "on   stochastic-switch",
         "off  depth-of-field",
-        "off  transmission             slot for later work",
+        "off  transmission             needs a recipe `body`",
     ] {
         assert!(text.contains(expected), "missing {expected:?} in\n{text}");
     }

@@ -80,6 +80,13 @@ impl Spectral for Grey4 {
     const WAVELENGTH_DIMENSIONS: u32 = 1;
     const ZERO: Self = Grey4([0.0; 4]);
     const ONE: Self = Grey4([1.0; 4]);
+    const CHANNELS: usize = 4;
+    fn channel(self, i: usize) -> f32 {
+        self.0[i]
+    }
+    fn map(self, f: impl Fn(f32) -> f32) -> Self {
+        Grey4(self.0.map(f))
+    }
     fn splat(v: f32) -> Self {
         Grey4([v; 4])
     }

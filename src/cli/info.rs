@@ -98,7 +98,7 @@ pub fn describe(recipe: &GemRecipe, scene: &Scene, points: u32) -> String {
 
     // Shares over the surface.
     let pts = surface_points(&scene.stage.shape, points, hash_words(&[scene.hash, 7]));
-    let mut counts = vec![0u32; s.names.len()];
+    let mut counts = vec![0u32; s.leaf_names().len()];
     let mut rng = Rng::new(hash_words(&[scene.hash, 8]));
     for p in &pts {
         counts[s.map.lookup(*p, rng.uniform()).material as usize] += 1;
@@ -130,6 +130,28 @@ pub fn describe(recipe: &GemRecipe, scene: &Scene, points: u32) -> String {
             100.0 * f64::from(counts[i]) / f64::from(points),
             format!("{:#}", s.stacks[i].model),
             if s.used[i] { "" } else { "  (unused)" }
+        );
+    }
+    if let Some(b) = &s.body {
+        let i = s.body_index() as usize;
+        let boundary = if b.alpha == 0.0 {
+            "smooth".to_string()
+        } else {
+            format!("{:?} α {:.4}, {:?}", b.distribution, b.alpha, b.masking)
+        };
+        let interior = match &b.medium {
+            Some(m) if b.has_medium() => format!(
+                "σa {:.4?}, σs {:.4?} per object unit, g {}",
+                m.sigma_a.0, m.sigma_s.0, m.g
+            ),
+            _ => "clear".into(),
+        };
+        let _ = writeln!(
+            o,
+            "  {i:>3}  {:<width$}  {:>6.2}%  body: IOR {}, {boundary} boundary; interior {interior}",
+            "Body",
+            100.0 * f64::from(counts[i]) / f64::from(points),
+            b.ior
         );
     }
 
@@ -276,6 +298,18 @@ pub fn describe(recipe: &GemRecipe, scene: &Scene, points: u32) -> String {
         "  render       {}×{}, {} spp, max depth {}, {:?} sampler, {:?} filter, exposure {}, seed {}",
         r.width, r.height, r.spp, r.max_depth, r.sampler, r.filter, r.exposure, r.seed
     );
+    if scene.surface.body.is_some() {
+        let _ = writeln!(
+            o,
+            "  medium       depth {}, scattering {}",
+            r.medium_depth,
+            if r.medium_scattering {
+                "on"
+            } else {
+                "off (absorption only)"
+            }
+        );
+    }
 
     // Effects.
     let _ = writeln!(o, "\neffects:");

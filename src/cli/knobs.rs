@@ -85,7 +85,7 @@ fn fresnel_arg(s: &str) -> Result<FresnelMode, String> {
     parse_fresnel(s).map_err(|e| e.0)
 }
 
-fn switch_arg(s: &str) -> Result<bool, String> {
+pub(crate) fn switch_arg(s: &str) -> Result<bool, String> {
     parse_switch("value", s).map_err(|e| e.0)
 }
 
@@ -117,6 +117,8 @@ fn knob_of(key: &str) -> Option<String> {
     match key {
         "model" | "fresnel" | "sampler" => Some(key.into()),
         "max-depth" | "max_depth" => Some("max-depth".into()),
+        "medium-depth" | "medium_depth" => Some("medium-depth".into()),
+        "medium-scattering" | "medium_scattering" => Some("medium-scattering".into()),
         _ => effect_named(key).map(|e| e.name().to_string()),
     }
 }

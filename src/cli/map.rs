@@ -174,11 +174,14 @@ pub fn run(args: &MapArgs) -> Result<()> {
             surface.map.lookup(args.plane.point(a, b), u)
         })
         .collect();
-    let mats = surface.names.len();
+    let names = surface.leaf_names();
+    let mats = names.len();
     let colours: Vec<[u8; 3]> = (0..mats)
-        .map(|i| match args.colours {
-            Colours::Material => palette(i),
-            Colours::Albedo => preview_colour(&surface.stacks[i]),
+        .map(|i| match (args.colours, surface.stacks.get(i)) {
+            (Colours::Material, _) => palette(i),
+            (Colours::Albedo, Some(stack)) => preview_colour(stack),
+            // The translucent body: a pale glass tone.
+            (Colours::Albedo, None) => [225, 232, 240],
         })
         .collect();
     let mut count = vec![0usize; mats];
@@ -221,7 +224,7 @@ pub fn run(args: &MapArgs) -> Result<()> {
         }
     }
     if !args.no_legend {
-        draw_legend(&mut buf, (w, h), n, &surface.names, &colours, &count)?;
+        draw_legend(&mut buf, (w, h), n, &names, &colours, &count)?;
     }
     let img = image::RgbImage::from_raw(w as u32, h as u32, buf)
         .ok_or_else(|| anyhow!("map: buffer size"))?;
@@ -244,7 +247,7 @@ pub fn run(args: &MapArgs) -> Result<()> {
         n,
         args.out.display()
     )?;
-    for (i, name) in surface.names.iter().enumerate() {
+    for (i, name) in names.iter().enumerate() {
         writeln!(out, "  {:>6.2} %  {name}", 100.0 * count[i] as f64 / total)?;
     }
     writeln!(

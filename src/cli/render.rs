@@ -51,6 +51,13 @@ pub struct RenderArgs {
     /// Longest path in scattering events (default: the recipe's, else 8).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub max_depth: Option<u32>,
+    /// Most scattering events inside a translucent body's medium per path (default: the
+    /// recipe's, else 256).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=4096))]
+    pub medium_depth: Option<u32>,
+    /// Whether a body's medium scatters (`off`: absorption only; default: the recipe's, else on).
+    #[arg(long, value_parser = super::knobs::switch_arg)]
+    pub medium_scattering: Option<bool>,
     /// Stop after this many seconds, setup included, and write what was rendered (marked
     /// partial; nothing when not one pass completed).
     #[arg(long, allow_hyphen_values = true, value_parser = parse_seconds)]
@@ -203,6 +210,12 @@ fn settings(args: &RenderArgs, scene: &mut Scene) {
     }
     if let Some(d) = args.max_depth {
         r.max_depth = d;
+    }
+    if let Some(d) = args.medium_depth {
+        r.medium_depth = d;
+    }
+    if let Some(s) = args.medium_scattering {
+        r.medium_scattering = s;
     }
     if let Some(e) = args.exposure {
         r.exposure = e;

@@ -102,6 +102,27 @@ impl Stone {
         })
     }
 
+    /// Whether world point `p` lies inside the stone: the first surface a ray from `p` meets is
+    /// seen from its back (the surface's own normals point outward on a closed, consistently
+    /// wound stone). Tried along three fixed directions; the majority decides, so a ray grazing an
+    /// edge cannot flip the answer alone.
+    pub fn contains(&self, p: Vec3) -> bool {
+        let dirs = [
+            Vec3::new(0.267, 0.534, 0.802),
+            Vec3::new(-0.577, -0.211, 0.789),
+            Vec3::new(0.123, -0.911, -0.394),
+        ];
+        let inside = dirs
+            .iter()
+            .filter(|d| {
+                let d = d.normalize();
+                self.intersect(&Ray::new(p, d), f32::INFINITY)
+                    .is_some_and(|h| h.ng.dot(d) > 0.0)
+            })
+            .count();
+        inside >= 2
+    }
+
     /// Whether the stone blocks the world ray anywhere in `0 < t < t_max`.
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
         self.solid.occluded(&self.object_ray(ray), t_max)

@@ -6,11 +6,11 @@
 
 use super::RecipeError;
 use super::gem::GemRecipe;
-use super::map_compiler::Compiler;
+use super::map_compiler::{BODY_LEAF, Compiler};
 use super::source::Source;
 use crate::bsdf::StackDesc;
 use crate::sampler::hash_words;
-use crate::scene::{Accuracy, Effect, Scene, Surface, accuracy};
+use crate::scene::{Accuracy, Body, Effect, Interior, Scene, Surface, accuracy};
 use crate::texture::{Map, MapNode};
 use std::collections::HashSet;
 use std::path::Path;
@@ -131,12 +131,22 @@ impl Compiler<'_> {
             );
         }
         let mut used = vec![false; self.materials.len()];
-        let (nodes, entries, stops, fields) = (
+        let (mut nodes, entries, stops, fields) = (
             std::mem::take(&mut self.nodes),
             std::mem::take(&mut self.entries),
             std::mem::take(&mut self.stops),
             std::mem::take(&mut self.fields),
         );
+        // `Body` leaves point one past the material table.
+        let body_index = self.materials.len() as u32;
+        let mut body_shown = false;
+        for n in &mut nodes {
+            if *n == MapNode::Material(BODY_LEAF) {
+                *n = MapNode::Material(body_index);
+                body_shown = true;
+            }
+        }
+        let body = self.body(body_shown, warnings);
         for n in &nodes {
             // Stand-ins for unknown names point at material 0, which need not exist.
             if let MapNode::Material(m) = n
@@ -191,6 +201,7 @@ impl Compiler<'_> {
                     .enumerate()
                     .map(|(i, u)| *u || i >= own)
                     .collect(),
+                body,
             },
             stage,
             effects: self.effects,
@@ -251,6 +262,59 @@ impl Compiler<'_> {
         }
         let e = r.source.error(at, "");
         Some((acc, format!("render.accuracy ({}:{})", e.file, e.line)))
+    }
+
+    /// The recipe's `body`, checked (errors recorded), and the effects it calls for when the
+    /// surface shows it.
+    fn body(&mut self, shown: bool, warnings: &mut Vec<RecipeError>) -> Option<Body> {
+        let r = self.recipe;
+        let desc = r.content.body.as_ref()?;
+        let at = r.source.find(&["body", ":"]);
+        let e = r.source.error(at, "");
+        let place = format!("body ({}:{})", e.file, e.line);
+        let alpha = match desc.alpha() {
+            Ok(a) => a,
+            Err(m) => {
+                self.errors.push(r.source.error(at, m));
+                return None;
+            }
+        };
+        let medium = match &desc.medium {
+            None => None,
+            Some(m) => match m.coefficients() {
+                Ok((sigma_a, sigma_s)) => Some(Interior {
+                    sigma_a,
+                    sigma_s,
+                    g: m.phase.g(),
+                }),
+                Err(msg) => {
+                    let at = r.source.find_from(at.unwrap_or(0), &["medium", ":"]).or(at);
+                    self.errors.push(r.source.error(at, format!("body.{msg}")));
+                    return None;
+                }
+            },
+        };
+        let body = Body {
+            ior: desc.ior,
+            alpha,
+            distribution: desc.distribution,
+            masking: desc.masking,
+            medium,
+        };
+        if shown {
+            self.effects.turn_on(Effect::Transmission, place.clone());
+            if body.has_medium() {
+                self.effects
+                    .turn_on(Effect::Medium, format!("{place} medium"));
+            }
+        } else {
+            warnings.push(r.source.error(
+                at,
+                "the recipe has a `body` but the surface never shows it (`Body`): the stone is \
+                 opaque",
+            ));
+        }
+        Some(body)
     }
 
     /// Effects a used material calls for.

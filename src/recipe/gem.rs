@@ -7,6 +7,7 @@
 //!     include: ["../materials/course.ron"],     // optional: material libraries
 //!     materials: { "name": (coats: [...], base: ...), ... },
 //!     maps: { "tiles": Voronoi(...), ... },     // optional: sub-maps used as Map("tiles")
+//!     body: (ior: 1.52, medium: (...)),         // optional: a translucent body (`body.rs`)
 //!     surface: Overlay(under: ..., over: ...),  // the tree (see `surface.rs`)
 //!     stage: (camera: ..., render: (...)),      // optional: replaces parts of the studio stage
 //! )
@@ -38,6 +39,7 @@
 //! # Ok::<(), lapidary::recipe::RecipeError>(())
 //! ```
 
+use super::body::BodyDesc;
 use super::source::Source;
 use super::stage::StageDesc;
 use super::surface::MapDesc;
@@ -62,6 +64,10 @@ pub struct GemDesc {
     /// Named sub-maps, usable as `Map("name")` anywhere in the tree.
     #[serde(default, deserialize_with = "super::ranged::named_maps")]
     pub maps: IndexMap<String, MapDesc>,
+    /// A translucent body (issue 17): the boundary and the interior that `Body` leaves of the
+    /// surface show ([`BodyDesc`]). Without it the stone is opaque.
+    #[serde(default)]
+    pub body: Option<BodyDesc>,
     /// The surface map tree.
     pub surface: MapDesc,
     /// Parts of the studio stage to replace.

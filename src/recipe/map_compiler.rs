@@ -19,6 +19,10 @@ use std::collections::HashSet;
 /// has its own, equal limit ([`crate::texture::map::MAX_DEPTH`]).
 const MAX_NESTING: usize = crate::texture::map::MAX_DEPTH;
 
+/// The leaf index `Body` compiles to until the material table is complete; then it becomes
+/// [`crate::scene::Surface::body_index`].
+pub(super) const BODY_LEAF: u32 = u32::MAX;
+
 /// Unknown names reported with a did-you-mean hint, at most.
 const MAX_HINTS: usize = 32;
 
@@ -140,6 +144,20 @@ impl<'a> Compiler<'a> {
     fn node_inner(&mut self, desc: &MapDesc, at: &str) -> NodeId {
         let r = self.recipe;
         match desc {
+            MapDesc::Body => {
+                if r.content.body.is_none() {
+                    let at = r.source.find(&["Body"]);
+                    self.report_once(
+                        "no body".into(),
+                        at,
+                        "`Body` shows the recipe's translucent body, but the recipe has no \
+                         `body: (ior: …)`"
+                            .into(),
+                    );
+                    return self.push(MapNode::Material(0));
+                }
+                self.push(MapNode::Material(BODY_LEAF))
+            }
             MapDesc::Material(name) => {
                 let Some(lib_index) = r.library.index_of(name) else {
                     self.unknown("Material", name, |c| {

@@ -8,6 +8,7 @@
 
 #[macro_use]
 mod ranged;
+pub mod body;
 pub mod color;
 mod compile;
 pub mod gem;
@@ -19,6 +20,7 @@ pub mod source;
 pub mod stage;
 pub mod surface;
 
+pub use body::{BodyDesc, MediumDesc, PhaseDesc};
 pub use compile::Report;
 pub use gem::{GemDesc, GemRecipe};
 pub use library::{COURSE_CATALOGUE, MaterialFile, MaterialLibrary};

@@ -225,6 +225,8 @@ pub(crate) fn stage(
     }
     rs.spp = rd.spp.unwrap_or(rs.spp);
     rs.max_depth = rd.max_depth.unwrap_or(rs.max_depth);
+    rs.medium_depth = rd.medium_depth.unwrap_or(rs.medium_depth);
+    rs.medium_scattering = rd.medium_scattering.unwrap_or(rs.medium_scattering);
     rs.exposure = rd.exposure.unwrap_or(rs.exposure);
     rs.seed = rd.seed.unwrap_or(rs.seed);
     if let Some(s) = rd.sampler {

@@ -126,6 +126,9 @@ fn spp_range<'de, D: Deserializer<'de>>(d: D) -> Result<Option<u32>, D::Error> {
 fn depth_range<'de, D: Deserializer<'de>>(d: D) -> Result<Option<u32>, D::Error> {
     count(d, "max_depth", 1, 1024)
 }
+fn medium_depth_range<'de, D: Deserializer<'de>>(d: D) -> Result<Option<u32>, D::Error> {
+    count(d, "medium_depth", 0, crate::scene::stage::MAX_MEDIUM_DEPTH)
+}
 fn seed_range<'de, D: Deserializer<'de>>(d: D) -> Result<Option<u64>, D::Error> {
     any_seed(d).map(Some)
 }
@@ -424,6 +427,12 @@ pub struct RenderDesc {
     /// Longest path in bounces, 1 ..= 1024.
     #[serde(default, deserialize_with = "depth_range")]
     pub max_depth: Option<u32>,
+    /// Most scattering events in a body's medium per path, 0 ..= 4096 (default 256).
+    #[serde(default, deserialize_with = "medium_depth_range")]
+    pub medium_depth: Option<u32>,
+    /// Whether a body's medium scatters (default true; false: absorption only).
+    #[serde(default)]
+    pub medium_scattering: Option<bool>,
     /// The sampler.
     #[serde(default)]
     pub sampler: Option<SamplerDesc>,

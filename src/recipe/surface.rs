@@ -147,6 +147,8 @@ impl From<Weight> for f32 {
 pub enum MapDesc {
     /// A material of the recipe's `materials`, by name.
     Material(String),
+    /// The bare boundary of the recipe's translucent `body`: light refracts into the stone.
+    Body,
     /// A map of the recipe's `maps`, by name.
     Map(String),
     /// A Voronoi surface or glitter map.

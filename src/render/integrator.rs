@@ -16,6 +16,17 @@
 //! scene never samples one, and its renders are bit-identical to the loop before transmission
 //! existed.
 //!
+//! **Media** (issue 17). A translucent body's interior is a homogeneous medium
+//! ([`crate::medium`]). On every segment through it the free flight is sampled (chromatic
+//! coefficients by the one-sample MIS over channels); a scattering event picks a new direction
+//! from the phase function and counts towards `medium-depth`, not `max-depth`. There is no
+//! next-event estimation at medium points nor at opaque cells seen from inside: the medium is
+//! enclosed by the stone, whose boundary always refracts or is opaque, so no shadow ray from
+//! inside reaches a light; light behind a refracting boundary is found by BSDF and phase
+//! sampling, as in pbrt-v4 and Mitsuba 3. A rough boundary hit from inside does get next-event
+//! estimation through its transmission lobe (the shadow ray starts on the boundary, outside).
+//! Scenes without a body never run this code (the `transmission` and `medium` effects).
+//!
 //! **Variants.** [`trace`] is generic over the transported light `S` and monomorphised per variant
 //! ([`crate::spectrum`]); the film receives the path's radiance as a stored colour.
 //!
@@ -25,7 +36,8 @@ use super::path::{PathSample, PathState};
 use super::shading::{SurfaceBsdf, shade};
 use super::world::{Hit, LightRef, World};
 use crate::bsdf::{Bsdf, Bxdf, power_heuristic};
-use crate::geometry::{Ray, offset_origin};
+use crate::geometry::{MediumId, Ray, offset_origin};
+use crate::medium::FreeFlight;
 use crate::sampler::{PixelSampler, slots};
 use crate::spectrum::Spectral;
 use glam::Vec3;
@@ -74,11 +86,47 @@ where
     } else {
         S::sample_wavelengths(0.0)
     };
+    if world.camera_medium != MediumId::OUTSIDE {
+        ray.medium = world.camera_medium;
+    }
     let mut path = PathState::<S>::new(lambda, ray.medium);
     loop {
         sampler.skip_to(slots::bounce(path.depth));
         out.rays += 1;
-        let hit = match world.intersect(&ray, f32::INFINITY) {
+        let found = world.intersect(&ray, f32::INFINITY);
+        if world.medium {
+            let medium = &world.media[usize::from(path.medium.0)];
+            let t_hit = found.as_ref().map_or(f32::INFINITY, Hit::t);
+            let u = sampler.get2d_at(slots::medium(path.depth));
+            let hero = *path
+                .hero
+                .get_or_insert(((u.x * S::CHANNELS as f32) as usize).min(S::CHANNELS - 1));
+            match medium.free_flight::<S>(t_hit, hero, u.y, &path.lambda) {
+                FreeFlight::Pass { value, pdf } => path.take_flight(hero, value, pdf),
+                FreeFlight::Scatter { t, value, pdf } => {
+                    path.take_flight(hero, value, pdf);
+                    if path.medium_events >= world.medium_depth || !path.alive() {
+                        break;
+                    }
+                    let Some(phase) = medium.phase() else { break };
+                    let p = ray.at(t);
+                    let Some(ps) = phase.sample(-ray.dir, sampler.get2d()) else {
+                        break;
+                    };
+                    path.scatter_in_medium(ps.pdf, p);
+                    if path.depth >= RR_DEPTH {
+                        let q = path.survival();
+                        if !(sampler.get1d() < q) {
+                            break;
+                        }
+                        path.beta *= 1.0 / q;
+                    }
+                    ray = Ray::in_medium(p, ps.wi, path.medium);
+                    continue;
+                }
+            }
+        }
+        let hit = match found {
             None => {
                 let le = S::from_unbounded(world.environment.radiance(ray.dir), &path.lambda);
                 let w = emission_weight(world, strategy, &path, || {
@@ -117,13 +165,15 @@ where
         ) else {
             break;
         };
-        if path.depth >= max_depth {
+        if path.bounces() >= max_depth {
             break;
         }
         let wo_local = sb.frame.to_local(wo);
         let u_light = sampler.get1d();
         let u_point = sampler.get2d();
-        if strategy != Strategy::BsdfOnly && !sb.flags().is_specular_only() {
+        // Inside the stone only a transmitting boundary can see a light (module docs).
+        let sees_out = path.medium == MediumId::OUTSIDE || sb.flags().is_transmission();
+        if strategy != Strategy::BsdfOnly && !sb.flags().is_specular_only() && sees_out {
             direct_light(
                 world, strategy, &sb, wo_local, u_light, u_point, &mut path, &mut out,
             );
@@ -135,6 +185,10 @@ where
         let Some(bs) = sb.sample::<S>(wo_local, uc, u) else {
             break;
         };
+        if world.transmission_off && bs.flags.is_transmission() {
+            // `transmission=off`: the boundary only reflects.
+            break;
+        }
         path.scatter(&bs, sb.p, sb.inside);
         if path.depth >= RR_DEPTH {
             let q = path.survival();
@@ -177,7 +231,7 @@ fn direct_light<S: Spectral>(
     let Some(ls) = sample else {
         return;
     };
-    if !sb.admits(ls.wi) {
+    if !sb.admits(ls.wi) || (world.transmission_off && ls.wi.dot(sb.ng) < 0.0) {
         return;
     }
     let (wi_local, f) = sb.eval::<S>(wo_local, ls.wi);
@@ -200,7 +254,7 @@ fn direct_light<S: Spectral>(
         _ => 1.0,
     };
     let radiance = S::from_unbounded(ls.radiance, &path.lambda);
-    let c = path.beta * f * radiance * (wi_local.z.abs() * w / p_light);
+    let c = path.throughput() * f * radiance * (wi_local.z.abs() * w / p_light);
     if c.is_valid() {
         path.l += c;
     }

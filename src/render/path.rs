@@ -45,6 +45,12 @@ pub struct PathState<S: Spectral> {
     pub beta: S,
     /// Radiance gathered so far.
     pub l: S,
+    /// Per channel, the product along the path of the free-flight densities over the hero
+    /// channel's ([`crate::medium`]): contributions are divided by its mean. All ones until the
+    /// first medium segment, and unused ([`PathState::hero`] `None`) on paths that meet no medium.
+    pub r: S,
+    /// The channel free flights are sampled from, picked at the path's first medium segment.
+    pub hero: Option<usize>,
     /// The product of `η²` of the refractions so far (pbrt-v4 §14.1.5): Russian roulette looks at
     /// `β · eta_scale`, which removes the radiance compression of entering a denser medium.
     pub eta_scale: f32,
@@ -52,8 +58,10 @@ pub struct PathState<S: Spectral> {
     pub medium: MediumId,
     /// The path's wavelengths (zero-sized in the RGB variant).
     pub lambda: S::Wavelengths,
-    /// Scattering events so far.
+    /// Scattering events so far (surface and medium; it positions the sampler's slots).
     pub depth: u32,
+    /// Of those, scattering events in a medium (bounded by `medium-depth`, not `max-depth`).
+    pub medium_events: u32,
     /// The event that produced the current ray; `None` for the camera ray.
     pub prev: Option<PrevVertex>,
 }
@@ -64,18 +72,73 @@ impl<S: Spectral> PathState<S> {
         PathState {
             beta: S::ONE,
             l: S::ZERO,
+            r: S::ONE,
+            hero: None,
             eta_scale: 1.0,
             medium,
             lambda,
             depth: 0,
+            medium_events: 0,
             prev: None,
+        }
+    }
+
+    /// Surface scattering events so far (what `max-depth` bounds).
+    #[inline]
+    pub fn bounces(&self) -> u32 {
+        self.depth - self.medium_events
+    }
+
+    /// Takes a scattering event in a medium at `p`: the free-flight weight has been applied; the
+    /// phase function's sample has weight 1, so only the vertex is recorded (its density for the
+    /// MIS weight of emission the new ray reaches).
+    #[inline]
+    pub fn scatter_in_medium(&mut self, pdf: f32, p: Vec3) {
+        self.depth += 1;
+        self.medium_events += 1;
+        self.prev = Some(PrevVertex {
+            pdf,
+            p,
+            flags: LobeFlags::DIFFUSE,
+        });
+    }
+
+    /// The throughput a contribution is weighted by: `β`, divided by the mean of the channel
+    /// ratios once the path has sampled a free flight.
+    #[inline]
+    pub fn throughput(&self) -> S {
+        match self.hero {
+            None => self.beta,
+            Some(_) => {
+                let m = self.r.average();
+                if m > 0.0 {
+                    self.beta * (1.0 / m)
+                } else {
+                    S::ZERO
+                }
+            }
         }
     }
 
     /// Adds emitted radiance `le` reaching the path with MIS weight `w`.
     #[inline]
     pub fn add_emission(&mut self, le: S, w: f32) {
-        self.l += self.beta * le * w;
+        self.l += self.throughput() * le * w;
+    }
+
+    /// Takes a free flight's `value` and per-channel `pdf` ([`crate::medium::FreeFlight`]):
+    /// `β ← β·value/p_hero`, `r ← r·pdf/p_hero`. `hero` is the path's hero channel. A zero hero
+    /// density ends the path (its throughput becomes zero).
+    #[inline]
+    pub fn take_flight(&mut self, hero: usize, value: S, pdf: S) {
+        let ph = pdf.channel(hero);
+        if ph > 0.0 {
+            let inv = 1.0 / ph;
+            self.beta *= value * inv;
+            self.r *= pdf * inv;
+        } else {
+            self.beta = S::ZERO;
+        }
     }
 
     /// Takes the scattering event `bs` at `p`: multiplies the throughput, records the vertex and,
@@ -106,13 +169,13 @@ impl<S: Spectral> PathState<S> {
     /// The survival probability of Russian roulette, `min(1, max β·eta_scale)`.
     #[inline]
     pub fn survival(&self) -> f32 {
-        (self.beta * self.eta_scale).max_channel().min(1.0)
+        (self.throughput() * self.eta_scale).max_channel().min(1.0)
     }
 
     /// False once the throughput is zero or invalid: the path carries nothing more.
     #[inline]
     pub fn alive(&self) -> bool {
-        self.beta.is_valid() && !self.beta.is_black()
+        self.beta.is_valid() && !self.beta.is_black() && self.r.is_valid()
     }
 }
 

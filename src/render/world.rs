@@ -6,6 +6,7 @@ use crate::color::Rgb;
 use crate::geometry::{GeometryError, MediumId, Ray, Stone, StoneHit};
 use crate::image::ImageError;
 use crate::light::{Area, EnvironmentLight};
+use crate::medium::Medium;
 use crate::scene::{Effect, Scene};
 use crate::spectrum::RgbSample;
 use crate::texture::{Map, MapEffects};
@@ -127,10 +128,21 @@ pub struct World {
     pub materials: Vec<Option<Bsdf>>,
     /// Directional albedo at normal incidence by material index (for the albedo AOV).
     pub albedo: Vec<Rgb>,
-    /// The medium inside the stone: what a transmission through its surface enters. Every stone
-    /// is opaque or clear today, so this is [`MediumId::OUTSIDE`]; translucent bodies (issue 17)
-    /// give it an index into the world's media.
+    /// The medium inside the stone: what a transmission through its surface enters
+    /// ([`MediumId::OUTSIDE`] for an opaque stone, `MediumId(1)` for a translucent body).
     pub interior: MediumId,
+    /// The media by [`MediumId`]: 0 is the outside (a vacuum), 1 a body's interior.
+    pub media: Vec<Medium>,
+    /// The medium camera rays start in (the interior when the camera is inside the stone).
+    pub camera_medium: MediumId,
+    /// Most scattering events in a medium per path.
+    pub medium_depth: u32,
+    /// `transmission=off`: a body's boundary only reflects (a path ends where it would refract,
+    /// and next-event estimation skips directions through the surface).
+    pub transmission_off: bool,
+    /// Whether the free-flight code runs on every segment (the `medium` effect): a body with an
+    /// absorbing or scattering interior, or the effect forced on.
+    pub medium: bool,
     /// The map tree.
     pub map: Map,
     /// Whether facet bumps apply.
@@ -227,6 +239,49 @@ impl World {
                 }
             }
         }
+        // The translucent body's boundary is material `body_index`, one past the stacks.
+        let body = scene.surface.body.as_ref();
+        let shows_body = scene.effects.on(Effect::Transmission) && body.is_some();
+        if let Some(b) = body {
+            debug_assert_eq!(materials.len(), scene.surface.body_index() as usize);
+            materials.push(Some(b.boundary()));
+            // A lossless boundary: everything that arrives leaves, reflected or refracted.
+            albedo.push(Rgb::ONE);
+        }
+        let scale = stage.to_world.matrix3.x_axis.length();
+        let medium_on = scene.effects.on(Effect::Medium);
+        let mut media = vec![if scene.effects.forced(Effect::Medium) == Some(true) {
+            // Forced on: the free-flight code runs on every segment, through a medium that
+            // neither absorbs nor scatters (its weight is exactly 1).
+            Medium::Homogeneous(crate::medium::Homogeneous {
+                sigma_a: Rgb::ZERO,
+                sigma_s: Rgb::ZERO,
+                phase: crate::medium::HenyeyGreenstein::new(0.0),
+            })
+        } else {
+            Medium::Vacuum
+        }];
+        let interior = match body {
+            Some(b) if shows_body => {
+                media.push(if medium_on {
+                    b.medium(scale, stage.render.medium_scattering)
+                } else {
+                    Medium::Vacuum
+                });
+                MediumId(1)
+            }
+            _ => MediumId::OUTSIDE,
+        };
+        let transmission = scene.effects.on(Effect::Transmission);
+        let camera_medium = if transmission && interior != MediumId::OUTSIDE {
+            if stone.contains(stage.camera.from) {
+                interior
+            } else {
+                MediumId::OUTSIDE
+            }
+        } else {
+            MediumId::OUTSIDE
+        };
         let ground = stage.ground.map(|g| {
             (
                 g.height,
@@ -279,7 +334,12 @@ impl World {
             light_prob,
             materials,
             albedo,
-            interior: MediumId::OUTSIDE,
+            interior,
+            media,
+            camera_medium,
+            medium_depth: stage.render.medium_depth,
+            transmission_off: scene.effects.forced(Effect::Transmission) == Some(false),
+            medium: medium_on,
             map: scene.surface.map.with_effects(MapEffects {
                 overlay: scene.effects.forced(Effect::GlitterOverlay) != Some(false),
                 blend: scene.effects.forced(Effect::StochasticSwitch) != Some(false),

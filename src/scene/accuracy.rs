@@ -163,7 +163,7 @@ impl Accuracy {
 }
 
 /// Every knob key [`Knobs::set`] accepts (the effect names of [`Effect::name`] work too).
-pub const KNOB_KEYS: [&str; 15] = [
+pub const KNOB_KEYS: [&str; 17] = [
     "model",
     "fresnel",
     "distribution",
@@ -179,6 +179,8 @@ pub const KNOB_KEYS: [&str; 15] = [
     "environment-importance",
     "sampler",
     "max-depth",
+    "medium-depth",
+    "medium-scattering",
 ];
 
 /// The effect a knob key names (`bump` is short for `facet-bump`).
@@ -257,6 +259,10 @@ pub struct Knobs {
     pub sampler: Option<SamplerKind>,
     /// Longest path in bounces (`None`: the recipe's).
     pub max_depth: Option<u32>,
+    /// Most scattering events in a medium (`None`: the recipe's).
+    pub medium_depth: Option<u32>,
+    /// Whether media scatter (`None`: the recipe's).
+    pub medium_scattering: Option<bool>,
 }
 
 impl Knobs {
@@ -286,6 +292,18 @@ impl Knobs {
                     })?;
                 self.max_depth = Some(d);
             }
+            "medium-depth" | "medium_depth" => {
+                let max = crate::scene::stage::MAX_MEDIUM_DEPTH;
+                let d: u32 = value.parse().ok().filter(|d| *d <= max).ok_or_else(|| {
+                    KnobError(format!(
+                        "medium-depth `{value}` is out of range: allowed 0 ..= {max}"
+                    ))
+                })?;
+                self.medium_depth = Some(d);
+            }
+            "medium-scattering" | "medium_scattering" => {
+                self.medium_scattering = Some(parse_switch("medium-scattering", value)?);
+            }
             _ => self.accuracy.set(key, value)?,
         }
         Ok(())
@@ -299,6 +317,12 @@ impl Knobs {
         }
         if let Some(d) = self.max_depth {
             scene.stage.render.max_depth = d;
+        }
+        if let Some(d) = self.medium_depth {
+            scene.stage.render.medium_depth = d;
+        }
+        if let Some(s) = self.medium_scattering {
+            scene.stage.render.medium_scattering = s;
         }
         scene.set_accuracy(&self.accuracy, by)
     }
@@ -338,6 +362,15 @@ impl fmt::Display for Knobs {
         }
         if let Some(d) = self.max_depth {
             parts.push(format!("max-depth={d}"));
+        }
+        if let Some(d) = self.medium_depth {
+            parts.push(format!("medium-depth={d}"));
+        }
+        if let Some(s) = self.medium_scattering {
+            parts.push(format!(
+                "medium-scattering={}",
+                if s { "on" } else { "off" }
+            ));
         }
         if parts.is_empty() {
             f.write_str("baseline")

@@ -18,7 +18,7 @@ pub enum Effect {
     GlitterOverlay,
     /// A `Switch` with a stochastic `blend` band.
     StochasticSwitch,
-    /// Light transmitted into a translucent body and volume scattering (later work).
+    /// Light transmitted into a translucent body (refraction in and out, total internal reflection).
     Transmission,
     /// Spectral rendering (later work; colours are RGB today).
     Spectral,
@@ -28,17 +28,20 @@ pub enum Effect {
     DepthOfField,
     /// Importance sampling of an environment map.
     EnvironmentImportance,
+    /// Absorption and scattering in a body's interior (a non-vacuum medium).
+    Medium,
 }
 
 impl Effect {
     /// Every effect, in a fixed order.
-    pub const ALL: [Effect; 10] = [
+    pub const ALL: [Effect; 11] = [
         Effect::Absorption,
         Effect::TTerm,
         Effect::FacetBump,
         Effect::GlitterOverlay,
         Effect::StochasticSwitch,
         Effect::Transmission,
+        Effect::Medium,
         Effect::Spectral,
         Effect::Fluorescence,
         Effect::DepthOfField,
@@ -54,6 +57,7 @@ impl Effect {
             Effect::GlitterOverlay => "glitter-overlay",
             Effect::StochasticSwitch => "stochastic-switch",
             Effect::Transmission => "transmission",
+            Effect::Medium => "medium",
             Effect::Spectral => "spectral",
             Effect::Fluorescence => "fluorescence",
             Effect::DepthOfField => "depth-of-field",
@@ -64,10 +68,7 @@ impl Effect {
     /// Whether this version can simulate the effect at all (the others are slots for later work:
     /// no recipe element turns them on yet).
     pub fn implemented(self) -> bool {
-        !matches!(
-            self,
-            Effect::Transmission | Effect::Spectral | Effect::Fluorescence
-        )
+        !matches!(self, Effect::Spectral | Effect::Fluorescence)
     }
 
     /// What turns the effect on.
@@ -82,7 +83,8 @@ impl Effect {
             Effect::FacetBump => "a Voronoi map with `bump`",
             Effect::GlitterOverlay => "an Overlay node",
             Effect::StochasticSwitch => "a Switch with blend > 0",
-            Effect::Transmission => "a translucent body",
+            Effect::Transmission => "a recipe `body` that the surface map shows (`Body`)",
+            Effect::Medium => "a `body` whose `medium` absorbs or scatters",
             Effect::Spectral => "spectral colours",
             Effect::Fluorescence => "a fluorescent material",
             Effect::DepthOfField => "a perspective camera with aperture > 0",

@@ -6,11 +6,13 @@
 //! which optional parts of the simulation the scene calls for, and why.
 
 pub mod accuracy;
+pub mod body;
 pub mod effects;
 pub mod stage;
 pub mod surface;
 
 pub use accuracy::{Accuracy, KnobError, Knobs};
+pub use body::{Body, Interior};
 pub use effects::{Effect, Effects};
 pub use stage::Stage;
 pub use surface::Surface;

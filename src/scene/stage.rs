@@ -170,8 +170,14 @@ pub struct RenderSettings {
     pub height: u32,
     /// Samples per pixel.
     pub spp: u32,
-    /// Longest path in bounces.
+    /// Longest path in bounces (surface scattering events).
     pub max_depth: u32,
+    /// Most scattering events inside a medium per path (`medium-depth`), 0 ..= 4096; the
+    /// medium's events do not count towards `max_depth`.
+    pub medium_depth: u32,
+    /// Whether media scatter (`medium-scattering=off`: the absorption-only approximation, where
+    /// light that would scatter goes straight on).
+    pub medium_scattering: bool,
     /// The sampler.
     pub sampler: SamplerKind,
     /// The pixel filter.
@@ -181,6 +187,11 @@ pub struct RenderSettings {
     /// Seed of the pixel samples.
     pub seed: u64,
 }
+
+/// The default of [`RenderSettings::medium_depth`].
+pub const DEFAULT_MEDIUM_DEPTH: u32 = 256;
+/// The largest [`RenderSettings::medium_depth`] a user may give.
+pub const MAX_MEDIUM_DEPTH: u32 = 4096;
 
 /// A resolved stage.
 #[derive(Clone, Debug, PartialEq)]
@@ -289,6 +300,8 @@ impl Stage {
                 height: 480,
                 spp: 64,
                 max_depth: 8,
+                medium_depth: DEFAULT_MEDIUM_DEPTH,
+                medium_scattering: true,
                 sampler: SamplerKind::Sobol,
                 filter: Filter::Gaussian { radius: 1.5 },
                 exposure: 0.0,

@@ -1,5 +1,6 @@
 //! The gem's compiled surface: its material table and map tree.
 
+use super::Body;
 use crate::bsdf::StackDesc;
 use crate::texture::Map;
 
@@ -14,9 +15,32 @@ pub struct Surface {
     pub map: Map,
     /// Whether the tree uses each material.
     pub used: Vec<bool>,
+    /// The translucent body, if the recipe gives one. Map leaves whose index is
+    /// [`Surface::body_index`] (one past the last stack) show the bare boundary (`Body`).
+    pub body: Option<Body>,
 }
 
 impl Surface {
+    /// The material index of `Body` leaves: one past the last layered material.
+    pub fn body_index(&self) -> u32 {
+        self.stacks.len() as u32
+    }
+
+    /// Every name a map leaf can carry, by index: the materials, then `"Body"` when the recipe
+    /// has a body.
+    pub fn leaf_names(&self) -> Vec<String> {
+        let mut v = self.names.clone();
+        if self.body.is_some() {
+            v.push("Body".into());
+        }
+        v
+    }
+
+    /// The name of material index `i` (`"Body"` for the body's index).
+    pub fn name(&self, i: u32) -> &str {
+        self.names.get(i as usize).map_or("Body", String::as_str)
+    }
+
     /// Names of materials the tree never uses.
     pub fn unused(&self) -> impl Iterator<Item = &str> {
         self.names

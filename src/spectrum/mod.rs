@@ -61,6 +61,8 @@ pub trait Spectral:
     const ZERO: Self;
     /// All channels one.
     const ONE: Self;
+    /// Number of channels (carried wavelengths; 3 for RGB).
+    const CHANNELS: usize;
     /// The same value in every channel.
     fn splat(v: f32) -> Self;
     /// The wavelengths of a camera path from the sampler's wavelength slot `u ∈ [0, 1)`
@@ -74,6 +76,10 @@ pub trait Spectral:
     /// The film colour of a path's radiance estimate carried at `lambda` (for a spectral variant
     /// this divides by the wavelengths' density and projects onto the colour matching functions).
     fn to_rgb(self, lambda: &Self::Wavelengths) -> Rgb;
+    /// Channel `i` (`i < CHANNELS`).
+    fn channel(self, i: usize) -> f32;
+    /// `f` applied to every channel.
+    fn map(self, f: impl Fn(f32) -> f32) -> Self;
     /// Largest channel (Russian roulette, lobe choice).
     fn max_channel(self) -> f32;
     /// Mean of the channels.

@@ -89,6 +89,15 @@ impl Spectral for RgbSample {
     const WAVELENGTH_DIMENSIONS: u32 = 0;
     const ZERO: Self = RgbSample::ZERO;
     const ONE: Self = RgbSample::ONE;
+    const CHANNELS: usize = CHANNELS;
+    #[inline]
+    fn channel(self, i: usize) -> f32 {
+        self.0[i]
+    }
+    #[inline]
+    fn map(self, f: impl Fn(f32) -> f32) -> Self {
+        RgbSample::map(self, f)
+    }
     #[inline]
     fn splat(v: f32) -> Self {
         RgbSample::splat(v)

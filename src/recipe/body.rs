@@ -1,0 +1,285 @@
+//! Serde description of a translucent stone's `body` (issue 17): the boundary (a smooth or rough
+//! dielectric interface) and the interior medium. It compiles into [`crate::scene::Body`].
+//!
+//! ```ron
+//! body: (
+//!     ior: 1.52,                       // absolute IOR of the stone, 1.0001 ..= 4
+//!     roughness: 2.0,                  // optional: RMS slope angle, degrees (or `alpha`); default smooth
+//!     distribution: Ggx,               // optional: Blinn | Beckmann | Ggx (default Ggx)
+//!     masking: Smith,                  // optional: VCavity | Smith | SmithSeparable (default Smith)
+//!     medium: (                        // optional: default clear (a vacuum inside)
+//!         colour: Srgb(0.9, 0.6, 0.3), // what white light keeps after `distance` ...
+//!         distance: 1.0,               // ... object units (or `absorption: (σr, σg, σb)`)
+//!         scattering: (4.0, 4.0, 4.0), // σs per object unit (default 0)
+//!         phase: HenyeyGreenstein(g: 0.3), // or Isotropic (default)
+//!     ),
+//! )
+//! ```
+//!
+//! **Units.** Coefficients are per **object unit**: the units the stone's shape is given in (a
+//! sphere's radius, a cabochon's semi-axes, a mesh's coordinates after its `scale`). The stage's
+//! uniform `transform.scale` is applied at compile time, so a scaled stone keeps its look.
+
+use super::color::ColorDesc;
+use crate::bsdf::{Distribution, Masking};
+use crate::color::Rgb;
+use crate::medium::phase::G_LIMIT;
+use serde::{Deserialize, Deserializer, Serialize};
+
+/// Largest coefficient (per object unit) a recipe may give.
+pub const SIGMA_MAX: f32 = 1e4;
+/// IOR range of a body.
+pub const BODY_IOR: (f32, f32) = (1.0001, 4.0);
+
+ranged!(ior_range, "body.ior", 1.0001, 4.0);
+ranged!(distance_range, "medium.distance", open 0.0, 1e4);
+ranged!(g_range, "g", -0.99, 0.99);
+
+/// A coefficient triple: finite, 0 ..= 1e4 per object unit.
+fn sigma<'de, D: Deserializer<'de>>(d: D) -> Result<(f32, f32, f32), D::Error> {
+    let v = <(f32, f32, f32)>::deserialize(d)?;
+    if [v.0, v.1, v.2]
+        .iter()
+        .all(|c| c.is_finite() && (0.0..=SIGMA_MAX).contains(c))
+    {
+        Ok(v)
+    } else {
+        Err(serde::de::Error::custom(format!(
+            "{v:?}: each coefficient must be 0 ..= {SIGMA_MAX} per object unit"
+        )))
+    }
+}
+
+fn opt_sigma<'de, D: Deserializer<'de>>(d: D) -> Result<Option<(f32, f32, f32)>, D::Error> {
+    sigma(d).map(Some)
+}
+
+/// A transmittance colour: linear, each channel 0 <.. 1.
+fn transmittance<'de, D: Deserializer<'de>>(d: D) -> Result<Option<ColorDesc>, D::Error> {
+    let c = ColorDesc::deserialize(d)?;
+    let rgb = c.to_rgb().map_err(serde::de::Error::custom)?;
+    if rgb.0.iter().all(|&v| v > 0.0 && v <= 1.0) {
+        Ok(Some(c))
+    } else {
+        Err(serde::de::Error::custom(format!(
+            "colour {c:?} is linear {:?}: each channel must be 0 <.. 1 (the share of white light \
+             left after `distance`)",
+            rgb.0
+        )))
+    }
+}
+
+fn opt_distance<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f32>, D::Error> {
+    distance_range(d).map(Some)
+}
+
+fn opt_angle<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f32>, D::Error> {
+    let v = f32::deserialize(d)?;
+    if v == 0.0 || (0.01..90.0).contains(&v) {
+        Ok(Some(v))
+    } else {
+        Err(serde::de::Error::custom(format!(
+            "body.roughness = {v} is out of range: allowed 0 (smooth) or 0.01 ..< 90 degrees"
+        )))
+    }
+}
+
+fn opt_alpha<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f32>, D::Error> {
+    let v = f32::deserialize(d)?;
+    let (lo, hi) = super::material::ALPHA_RANGE;
+    if v == 0.0 || (lo..=hi).contains(&v) {
+        Ok(Some(v))
+    } else {
+        Err(serde::de::Error::custom(format!(
+            "body.alpha = {v} is out of range: allowed 0 (smooth) or {lo} ..= {hi}"
+        )))
+    }
+}
+
+fn default_distribution() -> Distribution {
+    Distribution::Ggx
+}
+fn default_masking() -> Masking {
+    Masking::Smith
+}
+
+/// A translucent stone's body: boundary and interior.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BodyDesc {
+    /// Absolute IOR of the stone, 1.0001 ..= 4.
+    #[serde(deserialize_with = "ior_range")]
+    pub ior: f32,
+    /// Boundary roughness as the RMS slope angle in degrees, 0 (smooth, the default) or
+    /// 0.01 ..< 90. Exclusive with `alpha`.
+    #[serde(default, deserialize_with = "opt_angle")]
+    pub roughness: Option<f32>,
+    /// Boundary roughness as `α`, 0 (smooth) or 0.0002 ..= 10. Exclusive with `roughness`.
+    #[serde(default, deserialize_with = "opt_alpha")]
+    pub alpha: Option<f32>,
+    /// Micro-facet distribution of a rough boundary (default GGX, as pbrt-v4 and Mitsuba 3).
+    #[serde(default = "default_distribution")]
+    pub distribution: Distribution,
+    /// Masking of a rough boundary (default Smith, Walter et al. 2007).
+    #[serde(default = "default_masking")]
+    pub masking: Masking,
+    /// The interior; `None` is clear (nothing absorbs or scatters).
+    #[serde(default)]
+    pub medium: Option<MediumDesc>,
+}
+
+/// A homogeneous interior. Give the absorption either as coefficients or as a colour after a
+/// distance.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MediumDesc {
+    /// Absorption coefficient `σa` per object unit per channel, 0 ..= 1e4.
+    #[serde(default, deserialize_with = "opt_sigma")]
+    pub absorption: Option<(f32, f32, f32)>,
+    /// The colour (linear share, each channel 0 <.. 1) that white light keeps after travelling
+    /// `distance` through the body without scattering: `σa = −ln(colour)/distance`.
+    #[serde(default, deserialize_with = "transmittance")]
+    pub colour: Option<ColorDesc>,
+    /// The distance of `colour`, object units, 0 <.. 1e4.
+    #[serde(default, deserialize_with = "opt_distance")]
+    pub distance: Option<f32>,
+    /// Scattering coefficient `σs` per object unit per channel, 0 ..= 1e4 (default 0).
+    #[serde(default, deserialize_with = "sigma")]
+    pub scattering: (f32, f32, f32),
+    /// The phase function (default isotropic).
+    #[serde(default)]
+    pub phase: PhaseDesc,
+}
+
+/// A phase function.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum PhaseDesc {
+    /// The same in every direction.
+    #[default]
+    Isotropic,
+    /// Henyey–Greenstein with mean cosine `g`, −0.99 ..= 0.99 (> 0 forward).
+    HenyeyGreenstein {
+        /// Asymmetry.
+        #[serde(deserialize_with = "g_range")]
+        g: f32,
+    },
+}
+
+impl PhaseDesc {
+    /// The asymmetry `g` (0 for isotropic).
+    pub fn g(self) -> f32 {
+        match self {
+            PhaseDesc::Isotropic => 0.0,
+            PhaseDesc::HenyeyGreenstein { g } => g.clamp(-G_LIMIT, G_LIMIT),
+        }
+    }
+}
+
+impl BodyDesc {
+    /// The boundary's `α` (0: smooth), or what is wrong.
+    pub fn alpha(&self) -> Result<f32, String> {
+        match (self.roughness, self.alpha) {
+            (Some(_), Some(_)) => {
+                Err("body: give either `roughness` (degrees) or `alpha`, not both".into())
+            }
+            (Some(m), None) => Ok(m.to_radians().tan()),
+            (None, Some(a)) => Ok(a),
+            (None, None) => Ok(0.0),
+        }
+    }
+}
+
+impl MediumDesc {
+    /// `σa` and `σs` per object unit, or what is wrong.
+    pub fn coefficients(&self) -> Result<(Rgb, Rgb), String> {
+        let sigma_a = match (&self.absorption, &self.colour, self.distance) {
+            (Some(a), None, None) => Rgb::new(a.0, a.1, a.2),
+            (None, Some(c), Some(d)) => {
+                let c = c.to_rgb()?;
+                Rgb(c.0.map(|v| (-v.ln() / d).max(0.0)))
+            }
+            (None, None, None) => Rgb::ZERO,
+            (Some(_), Some(_), _) | (Some(_), _, Some(_)) => {
+                return Err(
+                    "medium: give the absorption either as `absorption` or as `colour` and \
+                     `distance`, not both"
+                        .into(),
+                );
+            }
+            (None, Some(_), None) => {
+                return Err("medium: `colour` needs `distance` (object units, 0 <.. 1e4)".into());
+            }
+            (None, None, Some(_)) => {
+                return Err("medium: `distance` needs `colour`".into());
+            }
+        };
+        if sigma_a.0.iter().any(|&v| !(v <= SIGMA_MAX)) {
+            return Err(format!(
+                "medium: the colour gives absorption {:?} per object unit, above {SIGMA_MAX}",
+                sigma_a.0
+            ));
+        }
+        let s = self.scattering;
+        Ok((sigma_a, Rgb::new(s.0, s.1, s.2)))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<BodyDesc, String> {
+        crate::recipe::ron_options()
+            .from_str(text)
+            .map_err(|e| e.to_string())
+    }
+
+    #[test]
+    fn colour_form_converts_to_coefficients() {
+        let b = parse("(ior: 1.5, medium: (colour: Rgb(0.5, 1.0, 0.25), distance: 2.0))").unwrap();
+        let (a, s) = b.medium.as_ref().unwrap().coefficients().unwrap();
+        assert!((a.0[0] - std::f32::consts::LN_2 / 2.0).abs() < 1e-6);
+        assert_eq!(a.0[1], 0.0);
+        assert!((a.0[2] - 2.0 * std::f32::consts::LN_2 / 2.0).abs() < 1e-6);
+        assert_eq!(s, Rgb::ZERO);
+        assert_eq!(b.alpha().unwrap(), 0.0);
+    }
+
+    #[test]
+    fn bad_values_are_refused_with_the_range() {
+        for (text, needle) in [
+            ("(ior: 0.9)", "1.0001 ..= 4"),
+            ("(ior: 1.5, roughness: 95.0)", "0.01 ..< 90"),
+            ("(ior: 1.5, alpha: 20.0)", "0.0002 ..= 10"),
+            (
+                "(ior: 1.5, medium: (absorption: (1.0, -1.0, 0.0)))",
+                "0 ..= 10000",
+            ),
+            (
+                "(ior: 1.5, medium: (colour: Gray(0.0), distance: 1.0))",
+                "0 <.. 1",
+            ),
+            (
+                "(ior: 1.5, medium: (colour: Gray(0.5), distance: 0.0))",
+                "0 <.. 10000",
+            ),
+            (
+                "(ior: 1.5, medium: (phase: HenyeyGreenstein(g: 1.0)))",
+                "-0.99 ..= 0.99",
+            ),
+        ] {
+            let e = parse(text).unwrap_err();
+            assert!(e.contains(needle), "{text}: {e}");
+        }
+        let both = parse("(ior: 1.5, roughness: 2.0, alpha: 0.1)").unwrap();
+        assert!(both.alpha().is_err());
+        let half = parse("(ior: 1.5, medium: (colour: Gray(0.5)))").unwrap();
+        assert!(half.medium.unwrap().coefficients().is_err());
+        let two = parse(
+            "(ior: 1.5, medium: (absorption: (1.0, 1.0, 1.0), colour: Gray(0.5), distance: 1.0))",
+        )
+        .unwrap();
+        assert!(two.medium.unwrap().coefficients().is_err());
+    }
+}

@@ -1,0 +1,74 @@
+//! A translucent stone's compiled body (issue 17): the boundary interface and the interior
+//! medium, in **object units** (the world converts the coefficients with the stage's scale).
+
+use crate::bsdf::SmoothDielectric;
+use crate::bsdf::{Bsdf, Distribution, Masking, MicrofacetDistribution, RoughDielectric};
+use crate::color::Rgb;
+use crate::medium::{HenyeyGreenstein, Homogeneous, Medium};
+
+/// The body of a translucent stone.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Body {
+    /// Absolute IOR of the stone (the outside is air, IOR 1).
+    pub ior: f32,
+    /// Boundary roughness `α` (0: a smooth, specular boundary).
+    pub alpha: f32,
+    /// Micro-facet distribution of a rough boundary.
+    pub distribution: Distribution,
+    /// Masking of a rough boundary.
+    pub masking: Masking,
+    /// The interior, coefficients per object unit; `None` is clear.
+    pub medium: Option<Interior>,
+}
+
+/// A homogeneous interior as the recipe gives it (per object unit).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Interior {
+    /// Absorption coefficient per object unit.
+    pub sigma_a: Rgb,
+    /// Scattering coefficient per object unit.
+    pub sigma_s: Rgb,
+    /// Henyey–Greenstein asymmetry.
+    pub g: f32,
+}
+
+impl Body {
+    /// The boundary's BSDF: a smooth dielectric, or a rough one (Walter et al. 2007) with its
+    /// reciprocal multiple-scattering compensation (`bsdf::interface_energy`), so a lossless body
+    /// keeps all the energy that enters it. `eta` is inside over outside.
+    pub fn boundary(&self) -> Bsdf {
+        if self.alpha == 0.0 {
+            Bsdf::SmoothDielectric(SmoothDielectric::new(self.ior))
+        } else {
+            let d = MicrofacetDistribution::from_alpha(self.distribution, self.alpha)
+                .with_masking(self.masking);
+            Bsdf::Dielectric(RoughDielectric::new(d, self.ior).with_energy_tables())
+        }
+    }
+
+    /// The interior as a runtime medium in world units: `scale` is the stage's uniform
+    /// object-to-world scale; `scattering: false` is the absorption-only approximation.
+    pub fn medium(&self, scale: f32, scattering: bool) -> Medium {
+        match self.medium {
+            None => Medium::Vacuum,
+            Some(m) => {
+                let h = Homogeneous {
+                    sigma_a: m.sigma_a * (1.0 / scale),
+                    sigma_s: m.sigma_s * (1.0 / scale),
+                    phase: HenyeyGreenstein::new(m.g),
+                };
+                Medium::Homogeneous(if scattering {
+                    h
+                } else {
+                    h.without_scattering()
+                })
+            }
+        }
+    }
+
+    /// Whether the interior absorbs or scatters at all (the `medium` effect).
+    pub fn has_medium(&self) -> bool {
+        self.medium
+            .is_some_and(|m| m.sigma_a != Rgb::ZERO || m.sigma_s != Rgb::ZERO)
+    }
+}
