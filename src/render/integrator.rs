@@ -173,7 +173,8 @@ where
         let u_point = sampler.get2d();
         // Inside the stone only a transmitting boundary can see a light (module docs).
         let sees_out = path.medium == MediumId::OUTSIDE || sb.flags().is_transmission();
-        if strategy != Strategy::BsdfOnly && !sb.flags().is_specular_only() && sees_out {
+        let nee = strategy != Strategy::BsdfOnly && !sb.flags().is_specular_only() && sees_out;
+        if nee {
             direct_light(
                 world, strategy, &sb, wo_local, u_light, u_point, &mut path, &mut out,
             );
@@ -190,6 +191,9 @@ where
             break;
         }
         path.scatter(&bs, sb.p, sb.inside);
+        if !nee && let Some(v) = path.prev.as_mut() {
+            v.nee = false;
+        }
         if path.depth >= RR_DEPTH {
             let q = path.survival();
             if !(sampler.get1d() < q) {
@@ -260,9 +264,10 @@ fn direct_light<S: Spectral>(
     }
 }
 
-/// MIS weight of emission reached by the path's current ray (weight 1 for a camera ray and after
-/// a specular event, which light sampling cannot reproduce). `light_pdf` gives the light and its
-/// solid-angle density for the direction.
+/// MIS weight of emission reached by the path's current ray (weight 1 for a camera ray, after a
+/// specular event, which light sampling cannot reproduce, and after a vertex where no light was
+/// sampled — a medium point or a reflecting surface inside the stone). `light_pdf` gives the
+/// light and its solid-angle density for the direction.
 #[inline]
 fn emission_weight<S: Spectral>(
     world: &World,
@@ -273,7 +278,7 @@ fn emission_weight<S: Spectral>(
     let Some(prev) = path.prev else {
         return 1.0;
     };
-    if prev.flags.is_specular() {
+    if prev.flags.is_specular() || !prev.nee {
         return 1.0;
     }
     match strategy {

@@ -17,7 +17,9 @@
 //! `lapidary.sampler`, `lapidary.max_depth`, `lapidary.render_time` (seconds),
 //! `lapidary.dropped`, `lapidary.partial` (`true`/`false`), `lapidary.materials`
 //! (`index=name` pairs separated by `;`), `lapidary.accuracy` (the knobs of
-//! [`crate::scene::accuracy`] as `key=value,…`; empty when none).
+//! [`crate::scene::accuracy`] as `key=value,…`; empty when none), and for a scene with a
+//! translucent body `lapidary.medium` (`medium-depth=N,medium-scattering=on|off`; the body is
+//! the last entry of `lapidary.materials`, named `Body`).
 
 use super::Rendered;
 use crate::image::{Channel, ExrImage};
@@ -41,6 +43,8 @@ pub struct Metadata {
     pub materials: Vec<String>,
     /// Accuracy knobs applied (`key=value,…`, empty when none).
     pub accuracy: String,
+    /// The medium settings of a scene with a body (`None` without one: no attribute).
+    pub medium: Option<String>,
 }
 
 impl Metadata {
@@ -54,8 +58,15 @@ impl Metadata {
             spp: r.spp,
             sampler: r.sampler.name().to_string(),
             max_depth: r.max_depth,
-            materials: scene.surface.names.clone(),
+            materials: scene.surface.leaf_names(),
             accuracy: scene.accuracy.to_string(),
+            medium: scene.surface.body.as_ref().map(|_| {
+                format!(
+                    "medium-depth={},medium-scattering={}",
+                    r.medium_depth,
+                    if r.medium_scattering { "on" } else { "off" }
+                )
+            }),
         }
     }
 }
@@ -115,6 +126,11 @@ pub fn exr_image(r: &Rendered, meta: &Metadata) -> ExrImage {
     ]
     .into_iter()
     .map(|(k, v)| (k.to_string(), v))
+    .chain(
+        meta.medium
+            .iter()
+            .map(|m| ("lapidary.medium".to_string(), m.clone())),
+    )
     .collect();
     ExrImage {
         width: r.film.width,

@@ -35,6 +35,9 @@ pub struct PrevVertex {
     pub p: Vec3,
     /// The sampled lobe: a specular lobe has no density, so emission it reaches takes weight 1.
     pub flags: LobeFlags,
+    /// Whether next-event estimation ran at the vertex: where it did not (a medium point, a
+    /// reflecting surface inside the stone), emission the ray reaches takes weight 1.
+    pub nee: bool,
 }
 
 /// Everything a path knows between two vertices, generic over the transported light `S`.
@@ -100,6 +103,7 @@ impl<S: Spectral> PathState<S> {
             pdf,
             p,
             flags: LobeFlags::DIFFUSE,
+            nee: false,
         });
     }
 
@@ -163,6 +167,7 @@ impl<S: Spectral> PathState<S> {
             pdf: bs.pdf,
             p,
             flags: bs.flags,
+            nee: true,
         });
     }
 

@@ -34,6 +34,13 @@ pub enum WorldError {
     /// The environment map could not be read.
     #[error("environment map: {0}")]
     Environment(#[from] ImageError),
+    /// A translucent body on a mesh that is not closed and consistently wound: its inside is
+    /// undefined.
+    #[error(
+        "the stone's mesh has {0} open or inconsistently wound edges: a translucent body needs a \
+         closed mesh whose triangles are all wound counter-clockwise seen from outside"
+    )]
+    OpenBody(usize),
     /// The deadline passed or the cancel flag was set before the world was built.
     #[error("stopped during setup: nothing rendered, nothing written")]
     Stopped,
@@ -261,6 +268,12 @@ impl World {
         } else {
             Medium::Vacuum
         }];
+        if shows_body && let crate::geometry::Solid::Mesh(m) = stone.solid() {
+            let open = m.open_edges();
+            if open > 0 {
+                return Err(WorldError::OpenBody(open));
+            }
+        }
         let interior = match body {
             Some(b) if shows_body => {
                 media.push(if medium_on {
