@@ -304,8 +304,12 @@ impl Compiler<'_> {
         if shown {
             self.effects.turn_on(Effect::Transmission, place.clone());
             if body.has_medium() {
-                self.effects
-                    .turn_on(Effect::Medium, format!("{place} medium"));
+                let m = r.source.find_from(at.unwrap_or(0), &["medium", ":"]).or(at);
+                let e = r.source.error(m, "");
+                self.effects.turn_on(
+                    Effect::Medium,
+                    format!("body.medium ({}:{})", e.file, e.line),
+                );
             }
         } else {
             warnings.push(r.source.error(
