@@ -91,7 +91,7 @@ fn rows() -> Vec<Row> {
         row("missing_comma", (3, 4), &["Expected comma"], gem(" surface: Voronoi(scale: 0.1\n   fill: 0.5, entries: [(1.0, Material(\"a\"))])")),
         row("unclosed_paren", (2, 41), &["Expected comma"], s("(materials: {\n \"c\": (coats: [(ior: 1.5, roughness: 1.0], base: Lambert(albedo: Gray(0.5))),\n},\n surface: Material(\"c\"))")),
         row("unclosed_paren_at_eof", (2, 60), &["Expected comma", "the `(` at 2:18 is never closed"], s(M) + "\n surface: Overlay(under: Material(\"a\"), over: Material(\"b\")\n"),
-        row("unknown_top_field", (2, 2), &["`colour`", "`seed`, `include`, `materials`, `maps`, `surface`, or `stage`"], gem(" colour: 1,\n surface: Material(\"a\")")),
+        row("unknown_top_field", (2, 2), &["`colour`", "`seed`, `include`, `materials`, `maps`, `body`, `surface`, or `stage`"], gem(" colour: 1,\n surface: Material(\"a\")")),
         row("unknown_field_voronoi", (3, 4), &["`size` in `Voronoi`", "`scale`", "`entries`", "`fill`"], gem(" surface: Voronoi(scale: 0.1,\n   size: 2.0, entries: [(1.0, Material(\"a\"))])")),
         row("unknown_field_coat", (3, 66), &["`colour` in `CoatDesc`", "`ior`", "`tint`"], coat("ior: 1.5, roughness: 1.0, colour: 1")),
         row("unknown_field_stage", (4, 3), &["`lighting` in `StageDesc`", "`lights`", "`camera`"], stage("  lighting: [],")),
@@ -157,6 +157,16 @@ fn rows() -> Vec<Row> {
         row("blend_too_wide", (2, 44), &["blend = 0.5", "0 ..= 0.2", "narrowest gap"], gem(" surface: Switch(by: Constant(0.0), blend: 0.5,\n   stops: [(0.0, Material(\"a\")), (0.2, Material(\"b\"))],\n ")),
         row("map_cycle_used_first", (3, 51), &["map \"x\" contains itself"], gem(" surface: Map(\"x\"),\n maps: { \"x\": Voronoi(scale: 1.0, entries: [(1.0, Map(\"x\"))]) },")),
         row("nesting_too_deep", (34, 3), &["maps.\"m31\".stops[0]", "nest more than 64 levels", "too deep to evaluate"], deep_switches(70)),
+        // --- Translucent bodies (issue 17): numbers while parsing, combinations after.
+        row("body_ior", (2, 14), &["body.ior = 0.9", "1.0001 ..= 4"], gem(" body: (ior: 0.9),\n surface: Body")),
+        row("body_roughness", (2, 30), &["body.roughness = 95", "0.01 ..< 90"], gem(" body: (ior: 1.5, roughness: 95.0),\n surface: Body")),
+        row("body_alpha", (2, 26), &["body.alpha = 20", "0.0002 ..= 10"], gem(" body: (ior: 1.5, alpha: 20.0),\n surface: Body")),
+        row("body_roughness_and_alpha", (2, 2), &["body", "either `roughness` (degrees) or `alpha`, not both"], gem(" body: (ior: 1.5, roughness: 2.0, alpha: 0.1),\n surface: Body")),
+        row("body_sigma_negative", (3, 24), &["medium.absorption = (1.0, -1.0, 0.0)", "0 ..= 10000 per object unit"], gem(" body: (ior: 1.5,\n  medium: (absorption: (1.0, -1.0, 0.0))),\n surface: Body")),
+        row("body_colour_zero", (3, 20), &["medium.colour", "each channel must be 0 <.. 1"], gem(" body: (ior: 1.5,\n  medium: (colour: Gray(0.0), distance: 1.0)),\n surface: Body")),
+        row("body_colour_without_distance", (3, 3), &["body.medium", "`colour` needs `distance`"], gem(" body: (ior: 1.5,\n  medium: (colour: Gray(0.5))),\n surface: Body")),
+        row("body_g_one", (3, 39), &["phase g = 1", "-0.99 ..= 0.99"], gem(" body: (ior: 1.5,\n  medium: (phase: HenyeyGreenstein(g: 1.0))),\n surface: Body")),
+        row("body_missing", (2, 11), &["`Body`", "no `body: (ior: …)`"], gem(" surface: Body")),
         row("light_target_is_center", (6, 4), &["stage.lights[1]", "`target` equals `center`"], stage("  lights: [\n   Rect(center: (0.0, 4.0, 0.0), size: (1.0, 1.0), radiance: Gray(1.0)),\n   Disc(center: (1.0, 2.0, 3.0), target: (1.0, 2.0, 3.0), radius: 1.0, radiance: Gray(1.0)),\n  ],")),
     ];
     rows

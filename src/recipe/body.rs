@@ -33,10 +33,10 @@ pub const BODY_IOR: (f32, f32) = (1.0001, 4.0);
 
 ranged!(ior_range, "body.ior", 1.0001, 4.0);
 ranged!(distance_range, "medium.distance", open 0.0, 1e4);
-ranged!(g_range, "g", -0.99, 0.99);
+ranged!(g_range, "phase g", -0.99, 0.99);
 
-/// A coefficient triple: finite, 0 ..= 1e4 per object unit.
-fn sigma<'de, D: Deserializer<'de>>(d: D) -> Result<(f32, f32, f32), D::Error> {
+/// A coefficient triple named `what`: finite, 0 ..= 1e4 per object unit.
+fn sigma<'de, D: Deserializer<'de>>(d: D, what: &str) -> Result<(f32, f32, f32), D::Error> {
     let v = <(f32, f32, f32)>::deserialize(d)?;
     if [v.0, v.1, v.2]
         .iter()
@@ -45,13 +45,17 @@ fn sigma<'de, D: Deserializer<'de>>(d: D) -> Result<(f32, f32, f32), D::Error> {
         Ok(v)
     } else {
         Err(serde::de::Error::custom(format!(
-            "{v:?}: each coefficient must be 0 ..= {SIGMA_MAX} per object unit"
+            "medium.{what} = {v:?}: each coefficient must be 0 ..= {SIGMA_MAX} per object unit"
         )))
     }
 }
 
-fn opt_sigma<'de, D: Deserializer<'de>>(d: D) -> Result<Option<(f32, f32, f32)>, D::Error> {
-    sigma(d).map(Some)
+fn absorption<'de, D: Deserializer<'de>>(d: D) -> Result<Option<(f32, f32, f32)>, D::Error> {
+    sigma(d, "absorption").map(Some)
+}
+
+fn scattering<'de, D: Deserializer<'de>>(d: D) -> Result<(f32, f32, f32), D::Error> {
+    sigma(d, "scattering")
 }
 
 /// A transmittance colour: linear, each channel 0 <.. 1.
@@ -62,7 +66,7 @@ fn transmittance<'de, D: Deserializer<'de>>(d: D) -> Result<Option<ColorDesc>, D
         Ok(Some(c))
     } else {
         Err(serde::de::Error::custom(format!(
-            "colour {c:?} is linear {:?}: each channel must be 0 <.. 1 (the share of white light \
+            "medium.colour = {c:?} is linear {:?}: each channel must be 0 <.. 1 (the share of white light \
              left after `distance`)",
             rgb.0
         )))
@@ -134,7 +138,7 @@ pub struct BodyDesc {
 #[serde(deny_unknown_fields)]
 pub struct MediumDesc {
     /// Absorption coefficient `σa` per object unit per channel, 0 ..= 1e4.
-    #[serde(default, deserialize_with = "opt_sigma")]
+    #[serde(default, deserialize_with = "absorption")]
     pub absorption: Option<(f32, f32, f32)>,
     /// The colour (linear share, each channel 0 <.. 1) that white light keeps after travelling
     /// `distance` through the body without scattering: `σa = −ln(colour)/distance`.
@@ -144,7 +148,7 @@ pub struct MediumDesc {
     #[serde(default, deserialize_with = "opt_distance")]
     pub distance: Option<f32>,
     /// Scattering coefficient `σs` per object unit per channel, 0 ..= 1e4 (default 0).
-    #[serde(default, deserialize_with = "sigma")]
+    #[serde(default, deserialize_with = "scattering")]
     pub scattering: (f32, f32, f32),
     /// The phase function (default isotropic).
     #[serde(default)]
