@@ -39,6 +39,7 @@ pub mod geometry;
 pub mod image;
 pub mod light;
 pub mod medium;
+pub mod platelet;
 pub mod recipe;
 pub mod render;
 pub mod sampler;

@@ -21,6 +21,7 @@
 //! uniform `transform.scale` is applied at compile time, so a scaled stone keeps its look.
 
 use super::color::ColorDesc;
+use super::platelets::PlateletsDesc;
 use crate::bsdf::{Distribution, Masking};
 use crate::color::Rgb;
 use crate::medium::phase::G_LIMIT;
@@ -130,6 +131,9 @@ pub struct BodyDesc {
     /// The interior; `None` is clear (nothing absorbs or scatters).
     #[serde(default)]
     pub medium: Option<MediumDesc>,
+    /// Metal platelets suspended in the body (at most 8 populations; issue 18).
+    #[serde(default, deserialize_with = "super::platelets::population_list")]
+    pub platelets: Vec<PlateletsDesc>,
 }
 
 /// A homogeneous interior. Give the absorption either as coefficients or as a colour after a

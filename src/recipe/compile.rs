@@ -9,9 +9,12 @@ use super::gem::GemRecipe;
 use super::map_compiler::{BODY_LEAF, Compiler};
 use super::source::Source;
 use crate::bsdf::StackDesc;
+use crate::platelet::{Orientation, Population};
+use crate::recipe::platelets::OrientationDesc;
 use crate::sampler::hash_words;
 use crate::scene::{Accuracy, Body, Effect, Interior, Scene, Surface, accuracy};
 use crate::texture::{Map, MapNode};
+use glam::Vec3;
 use std::collections::HashSet;
 use std::path::Path;
 
@@ -146,7 +149,7 @@ impl Compiler<'_> {
                 body_shown = true;
             }
         }
-        let body = self.body(body_shown, warnings);
+        let body = self.body(body_shown, body_index, warnings);
         for n in &nodes {
             // Stand-ins for unknown names point at material 0, which need not exist.
             if let MapNode::Material(m) = n
@@ -266,7 +269,12 @@ impl Compiler<'_> {
 
     /// The recipe's `body`, checked (errors recorded), and the effects it calls for when the
     /// surface shows it.
-    fn body(&mut self, shown: bool, warnings: &mut Vec<RecipeError>) -> Option<Body> {
+    fn body(
+        &mut self,
+        shown: bool,
+        body_index: u32,
+        warnings: &mut Vec<RecipeError>,
+    ) -> Option<Body> {
         let r = self.recipe;
         let desc = r.content.body.as_ref()?;
         let at = r.source.find(&["body", ":"]);
@@ -294,15 +302,29 @@ impl Compiler<'_> {
                 }
             },
         };
+        let (platelets, platelet_materials) = self.platelets(desc, body_index, at.unwrap_or(0))?;
         let body = Body {
             ior: desc.ior,
             alpha,
             distribution: desc.distribution,
             masking: desc.masking,
             medium,
+            platelets,
+            platelet_materials,
         };
         if shown {
             self.effects.turn_on(Effect::Transmission, place.clone());
+            if !body.platelets.is_empty() {
+                let p = r
+                    .source
+                    .find_from(at.unwrap_or(0), &["platelets", ":"])
+                    .or(at);
+                let e = r.source.error(p, "");
+                self.effects.turn_on(
+                    Effect::Platelets,
+                    format!("body.platelets ({}:{})", e.file, e.line),
+                );
+            }
             if body.has_medium() {
                 let m = r.source.find_from(at.unwrap_or(0), &["medium", ":"]).or(at);
                 let e = r.source.error(m, "");
@@ -319,6 +341,97 @@ impl Compiler<'_> {
             ));
         }
         Some(body)
+    }
+
+    /// The body's platelet populations and the materials of their faces (each under the body's
+    /// IOR), indexed from `body_index + 1`; errors recorded (`None` after one).
+    #[allow(clippy::type_complexity)]
+    fn platelets(
+        &mut self,
+        desc: &crate::recipe::BodyDesc,
+        body_index: u32,
+        from: usize,
+    ) -> Option<(Vec<Population>, Vec<(String, StackDesc)>)> {
+        let r = self.recipe;
+        let mut pops = vec![];
+        let mut mats: Vec<(String, StackDesc)> = vec![];
+        let mut ok = true;
+        for (k, p) in desc.platelets.iter().enumerate() {
+            let at = r.source.find_from(from, &["platelets", ":"]);
+            let mut entries = vec![];
+            let total: f32 = p.entries.iter().map(|e| e.0).sum();
+            let mut acc = 0.0;
+            for e in &p.entries {
+                let name = &e.1;
+                let quoted = format!("{name:?}");
+                let pos = at.and_then(|a| r.source.find_from(a, &[&quoted])).or(at);
+                let stack = match r.library.stack(name) {
+                    Ok(mut s) => {
+                        s.outside_ior = desc.ior;
+                        s
+                    }
+                    Err(_) => {
+                        self.errors.push(r.source.error(
+                            pos,
+                            format!(
+                                "body.platelets[{k}]: unknown material \"{name}\" (platelet faces \
+                                 are the recipe's layered materials)"
+                            ),
+                        ));
+                        ok = false;
+                        continue;
+                    }
+                };
+                if let Err(e) = crate::bsdf::layered::validate(&stack) {
+                    self.errors.push(r.source.error(
+                        pos,
+                        format!("body.platelets[{k}]: material \"{name}\" under the body: {e}"),
+                    ));
+                    ok = false;
+                    continue;
+                }
+                let index = match mats.iter().position(|(n, _)| n == name) {
+                    Some(i) => i,
+                    None => {
+                        mats.push((name.clone(), stack));
+                        mats.len() - 1
+                    }
+                };
+                acc += e.0 / total;
+                entries.push((acc, body_index + 1 + index as u32));
+            }
+            if let Some(last) = entries.last_mut() {
+                last.0 = 1.0;
+            }
+            let orientation = match &p.orientation {
+                OrientationDesc::Uniform => Orientation::Uniform,
+                OrientationDesc::Aligned { axis, spread } => Orientation::Aligned {
+                    axis: Vec3::new(axis.0, axis.1, axis.2).normalize(),
+                    spread: spread.to_radians(),
+                },
+            };
+            let seed = p
+                .seed
+                .unwrap_or_else(|| hash_words(&[r.content.seed, 0x706c_6174, k as u64]));
+            match Population::new(p.density, p.radius, orientation, entries, seed) {
+                Some(pop) => pops.push(pop),
+                None => {
+                    self.errors.push(r.source.error(
+                        at,
+                        format!(
+                            "body.platelets[{k}]: density {} with radius up to {} puts more than \
+                             {} platelets in each cell of 2.2 × the largest radius on average: \
+                             they would overlap; lower the density or the radius",
+                            p.density,
+                            p.radius.1,
+                            crate::platelet::MAX_MEAN_PER_CELL
+                        ),
+                    ));
+                    ok = false;
+                }
+            }
+        }
+        ok.then_some((pops, mats))
     }
 
     /// Effects a used material calls for.

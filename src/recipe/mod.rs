@@ -15,6 +15,7 @@ pub mod gem;
 pub mod library;
 mod map_compiler;
 pub mod material;
+pub mod platelets;
 mod resolve;
 pub mod source;
 pub mod stage;

@@ -129,7 +129,7 @@ fn depth_range<'de, D: Deserializer<'de>>(d: D) -> Result<Option<u32>, D::Error>
 fn medium_depth_range<'de, D: Deserializer<'de>>(d: D) -> Result<Option<u32>, D::Error> {
     count(d, "medium_depth", 0, crate::scene::stage::MAX_MEDIUM_DEPTH)
 }
-fn seed_range<'de, D: Deserializer<'de>>(d: D) -> Result<Option<u64>, D::Error> {
+pub(crate) fn seed_range<'de, D: Deserializer<'de>>(d: D) -> Result<Option<u64>, D::Error> {
     any_seed(d).map(Some)
 }
 /// A seed: any `u64`, with the field's name and range when the literal is not one.

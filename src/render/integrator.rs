@@ -93,7 +93,13 @@ where
     loop {
         sampler.skip_to(slots::bounce(path.depth));
         out.rays += 1;
-        let found = world.intersect(&ray, f32::INFINITY);
+        let mut found = world.intersect(&ray, f32::INFINITY);
+        if !world.platelets.is_empty() && path.medium == world.interior {
+            let t_max = found.as_ref().map_or(f32::INFINITY, Hit::t);
+            if let Some(h) = world.platelet_hit(&ray, t_max, path.platelet) {
+                found = Some(h);
+            }
+        }
         if world.medium {
             let medium = &world.media[usize::from(path.medium.0)];
             let t_hit = found.as_ref().map_or(f32::INFINITY, Hit::t);
@@ -114,6 +120,7 @@ where
                         break;
                     };
                     path.scatter_in_medium(ps.pdf, p);
+                    path.platelet = None;
                     if path.depth >= RR_DEPTH {
                         let q = path.survival();
                         if !(sampler.get1d() < q) {
@@ -191,6 +198,10 @@ where
             break;
         }
         path.scatter(&bs, sb.p, sb.inside);
+        path.platelet = match hit {
+            Hit::Platelet { id, .. } => Some(id),
+            _ => None,
+        };
         if !nee && let Some(v) = path.prev.as_mut() {
             v.nee = false;
         }

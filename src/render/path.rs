@@ -54,6 +54,8 @@ pub struct PathState<S: Spectral> {
     pub r: S,
     /// The channel free flights are sampled from, picked at the path's first medium segment.
     pub hero: Option<usize>,
+    /// The platelet the current ray leaves from (it must not hit it again).
+    pub platelet: Option<crate::platelet::PlateletId>,
     /// The product of `η²` of the refractions so far (pbrt-v4 §14.1.5): Russian roulette looks at
     /// `β · eta_scale`, which removes the radiance compression of entering a denser medium.
     pub eta_scale: f32,
@@ -77,6 +79,7 @@ impl<S: Spectral> PathState<S> {
             l: S::ZERO,
             r: S::ONE,
             hero: None,
+            platelet: None,
             eta_scale: 1.0,
             medium,
             lambda,

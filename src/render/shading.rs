@@ -150,6 +150,22 @@ pub fn shade<'a, W: Copy>(
                 lambda,
             }
         }
+        Hit::Platelet {
+            t, p, n, material, ..
+        } => {
+            // A disc is two-sided: its faces look toward whichever side the path comes from.
+            let n = if wo.dot(n) >= 0.0 { n } else { -n };
+            t_hit = t;
+            ShadingContext {
+                p,
+                ng: n,
+                ns: n,
+                facet: None,
+                material: Some(material),
+                front: true,
+                lambda,
+            }
+        }
         Hit::Light { .. } => return None,
     };
     let sb = world.bsdf_at(&ctx, wo)?;

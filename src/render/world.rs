@@ -90,6 +90,19 @@ pub enum Hit {
         /// World point.
         p: Vec3,
     },
+    /// A platelet inside the body at distance `t`.
+    Platelet {
+        /// Distance along the ray.
+        t: f32,
+        /// World point.
+        p: Vec3,
+        /// Unit world normal of the disc (not oriented toward the ray).
+        n: Vec3,
+        /// Material index of its face.
+        material: u32,
+        /// Which platelet (a ray leaving it skips it).
+        id: crate::platelet::PlateletId,
+    },
     /// Area light `index` at distance `t`.
     Light {
         /// Index into [`World::areas`].
@@ -104,7 +117,7 @@ impl Hit {
     pub fn t(&self) -> f32 {
         match *self {
             Hit::Stone(h) => h.t,
-            Hit::Ground { t, .. } | Hit::Light { t, .. } => t,
+            Hit::Ground { t, .. } | Hit::Light { t, .. } | Hit::Platelet { t, .. } => t,
         }
     }
 }
@@ -147,6 +160,9 @@ pub struct World {
     /// `transmission=off`: a body's boundary only reflects (a path ends where it would refract,
     /// and next-event estimation skips directions through the surface).
     pub transmission_off: bool,
+    /// Platelet populations inside the body (object space), walked on every segment inside it
+    /// when the `platelets` effect is on.
+    pub platelets: Vec<crate::platelet::Population>,
     /// Whether the free-flight code runs on every segment (the `medium` effect): a body with an
     /// absorbing or scattering interior, or the effect forced on.
     pub medium: bool,
@@ -254,6 +270,18 @@ impl World {
             materials.push(Some(b.boundary()));
             // A lossless boundary: everything that arrives leaves, reflected or refracted.
             albedo.push(Rgb::ONE);
+            // Platelet faces, under the body's IOR, from `body_index + 1`.
+            for (name, desc) in &b.platelet_materials {
+                setup.check()?;
+                let mut stack = LayeredBsdf::new(desc).map_err(|source| WorldError::Material {
+                    name: format!("platelet:{name}"),
+                    source,
+                })?;
+                stack.force_absorption(scene.effects.forced(Effect::Absorption));
+                let bsdf = Bsdf::from(stack);
+                albedo.push(Rgb::from(normal_albedo(&bsdf)));
+                materials.push(Some(bsdf));
+            }
         }
         let scale = stage.to_world.matrix3.x_axis.length();
         let medium_on = scene.effects.on(Effect::Medium);
@@ -352,6 +380,10 @@ impl World {
             camera_medium,
             medium_depth: stage.render.medium_depth,
             transmission_off: scene.effects.forced(Effect::Transmission) == Some(false),
+            platelets: match body {
+                Some(b) if shows_body && scene.effects.on(Effect::Platelets) => b.platelets.clone(),
+                _ => vec![],
+            },
             medium: medium_on,
             map: scene.surface.map.with_effects(MapEffects {
                 overlay: scene.effects.forced(Effect::GlitterOverlay) != Some(false),
@@ -381,6 +413,33 @@ impl World {
             }
         }
         best
+    }
+
+    /// The nearest platelet along `ray` before `t_max` (a ray inside the body), skipping the
+    /// platelet `skip` it leaves from.
+    pub fn platelet_hit(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        skip: Option<crate::platelet::PlateletId>,
+    ) -> Option<Hit> {
+        let to_object = self.stone.to_object();
+        // An affine map keeps the ray parameter: `t` is the same in both spaces.
+        let o = to_object.transform_point3(ray.origin);
+        let d = to_object.transform_vector3(ray.dir);
+        let h = crate::platelet::grid::intersect(&self.platelets, o, d, 0.0, t_max, skip)?;
+        let n = self
+            .stone
+            .to_world()
+            .transform_vector3(h.normal)
+            .try_normalize()?;
+        Some(Hit::Platelet {
+            t: h.t,
+            p: ray.at(h.t),
+            n,
+            material: h.material,
+            id: h.id,
+        })
     }
 
     /// Whether anything blocks `ray` before `t_max`.

@@ -1,10 +1,11 @@
 //! A translucent stone's compiled body (issue 17): the boundary interface and the interior
 //! medium, in **object units** (the world converts the coefficients with the stage's scale).
 
-use crate::bsdf::SmoothDielectric;
 use crate::bsdf::{Bsdf, Distribution, Masking, MicrofacetDistribution, RoughDielectric};
+use crate::bsdf::{SmoothDielectric, StackDesc};
 use crate::color::Rgb;
 use crate::medium::{HenyeyGreenstein, Homogeneous, Medium};
+use crate::platelet::Population;
 
 /// The body of a translucent stone.
 #[derive(Clone, Debug, PartialEq)]
@@ -19,6 +20,12 @@ pub struct Body {
     pub masking: Masking,
     /// The interior, coefficients per object unit; `None` is clear.
     pub medium: Option<Interior>,
+    /// Platelet populations (object space); their entries index [`Body::platelet_materials`]
+    /// offset by `Surface::body_index() + 1`.
+    pub platelets: Vec<Population>,
+    /// The layered materials of platelet faces, by name, each with the body's IOR as its outside
+    /// medium.
+    pub platelet_materials: Vec<(String, StackDesc)>,
 }
 
 /// A homogeneous interior as the recipe gives it (per object unit).

@@ -30,11 +30,13 @@ pub enum Effect {
     EnvironmentImportance,
     /// Absorption and scattering in a body's interior (a non-vacuum medium).
     Medium,
+    /// Metal platelets suspended in a body (volumetric aventurescence).
+    Platelets,
 }
 
 impl Effect {
     /// Every effect, in a fixed order.
-    pub const ALL: [Effect; 11] = [
+    pub const ALL: [Effect; 12] = [
         Effect::Absorption,
         Effect::TTerm,
         Effect::FacetBump,
@@ -42,6 +44,7 @@ impl Effect {
         Effect::StochasticSwitch,
         Effect::Transmission,
         Effect::Medium,
+        Effect::Platelets,
         Effect::Spectral,
         Effect::Fluorescence,
         Effect::DepthOfField,
@@ -58,6 +61,7 @@ impl Effect {
             Effect::StochasticSwitch => "stochastic-switch",
             Effect::Transmission => "transmission",
             Effect::Medium => "medium",
+            Effect::Platelets => "platelets",
             Effect::Spectral => "spectral",
             Effect::Fluorescence => "fluorescence",
             Effect::DepthOfField => "depth-of-field",
@@ -85,6 +89,7 @@ impl Effect {
             Effect::StochasticSwitch => "a Switch with blend > 0",
             Effect::Transmission => "a recipe `body` that the surface map shows (`Body`)",
             Effect::Medium => "a `body` whose `medium` absorbs or scatters",
+            Effect::Platelets => "a `body` with `platelets`",
             Effect::Spectral => "spectral colours",
             Effect::Fluorescence => "a fluorescent material",
             Effect::DepthOfField => "a perspective camera with aperture > 0",

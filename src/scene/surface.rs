@@ -30,23 +30,42 @@ impl Surface {
     /// has a body.
     pub fn leaf_names(&self) -> Vec<String> {
         let mut v = self.names.clone();
-        if self.body.is_some() {
+        if let Some(b) = &self.body {
             v.push("Body".into());
+            v.extend(
+                b.platelet_materials
+                    .iter()
+                    .map(|(n, _)| format!("platelet:{n}")),
+            );
         }
         v
     }
 
-    /// The name of material index `i` (`"Body"` for the body's index).
+    /// The name of material index `i` (`"Body"` for the body's index, the material's own name
+    /// for a platelet face).
     pub fn name(&self, i: u32) -> &str {
-        self.names.get(i as usize).map_or("Body", String::as_str)
+        let n = self.names.len();
+        match (i as usize).checked_sub(n + 1) {
+            None => self.names.get(i as usize).map_or("Body", String::as_str),
+            Some(k) => self
+                .body
+                .as_ref()
+                .and_then(|b| b.platelet_materials.get(k))
+                .map_or("?", |(name, _)| name.as_str()),
+        }
     }
 
-    /// Names of materials the tree never uses.
+    /// Names of materials neither the tree nor a platelet population uses.
     pub fn unused(&self) -> impl Iterator<Item = &str> {
+        let plates: Vec<&str> = self
+            .body
+            .iter()
+            .flat_map(|b| b.platelet_materials.iter().map(|(n, _)| n.as_str()))
+            .collect();
         self.names
             .iter()
             .zip(&self.used)
-            .filter(|(_, u)| !**u)
+            .filter(move |(n, u)| !**u && !plates.contains(&n.as_str()))
             .map(|(n, _)| n.as_str())
     }
 }
