@@ -25,6 +25,8 @@
 //! inside reaches a light; light behind a refracting boundary is found by BSDF and phase
 //! sampling, as in pbrt-v4 and Mitsuba 3. A rough boundary hit from inside does get next-event
 //! estimation through its transmission lobe (the shadow ray starts on the boundary, outside).
+//! A scattering point within rounding of the boundary ahead is moved back by at most the spawn
+//! offset (`keep_off_the_boundary`), or its next ray could miss the boundary and leave the stone.
 //! Scenes without a body never run this code (the `transmission` and `medium` effects).
 //!
 //! **Variants.** [`trace`] is generic over the transported light `S` and monomorphised per variant
@@ -36,6 +38,7 @@ use super::path::{PathSample, PathState};
 use super::shading::{SurfaceBsdf, shade};
 use super::world::{Hit, LightRef, World};
 use crate::bsdf::{Bsdf, Bxdf, power_heuristic};
+use crate::geometry::ray::OFFSET_SCALE;
 use crate::geometry::{MediumId, Ray, offset_origin};
 use crate::medium::FreeFlight;
 use crate::sampler::{PixelSampler, slots};
@@ -115,7 +118,7 @@ where
                         break;
                     }
                     let Some(phase) = medium.phase() else { break };
-                    let p = ray.at(t);
+                    let p = keep_off_the_boundary(ray.at(t), &ray, found.as_ref());
                     let Some(ps) = phase.sample(-ray.dir, sampler.get2d()) else {
                         break;
                     };
@@ -219,6 +222,29 @@ where
     }
     out.radiance = path.l.to_rgb(&path.lambda);
     out
+}
+
+/// A medium scattering point `p` on `ray`, moved off the surface hit the ray was heading for
+/// (`found`) to at least the spawn offset ([`OFFSET_SCALE`]) on the ray's side of its tangent
+/// plane. A point sampled within rounding of the boundary would start rays that miss it (the
+/// sphere's exit root rounds to ≤ 0) and leave the stone without crossing its surface, then
+/// scatter in the interior medium outside the stone until `medium-depth` ends them with nothing
+/// (tests/translucent/furnace.rs: one path in ~10⁴–10⁵ at σs 10–100 per unit). The move is
+/// below the offset every spawned surface ray gets.
+#[inline]
+fn keep_off_the_boundary(p: Vec3, ray: &Ray, found: Option<&Hit>) -> Vec3 {
+    let Some(Hit::Stone(h)) = found else {
+        return p;
+    };
+    let eps = OFFSET_SCALE * h.p.abs().max_element().max(1.0);
+    // The normal facing away from the ray's side, and p's distance below the tangent plane.
+    let n = if h.ng.dot(ray.dir) > 0.0 { h.ng } else { -h.ng };
+    let depth = (h.p - p).dot(n);
+    if depth < eps {
+        p - n * (eps - depth)
+    } else {
+        p
+    }
 }
 
 /// Next-event estimation at `sb`: one light sample, weighted against BSDF sampling by `strategy`.
