@@ -56,6 +56,8 @@ fn interfaces() -> Vec<(String, RoughDielectric, RoughDielectric)> {
                 distribution: Distribution::Ggx,
                 masking: Masking::Smith,
                 medium: None,
+                platelets: vec![],
+                platelet_materials: vec![],
             };
             let Bsdf::Dielectric(full) = body.boundary() else {
                 panic!("a rough body has a rough boundary")
