@@ -32,8 +32,8 @@
 //!
 //! Runtime (release, two cores): ≈ 10 s for the file (`cargo test --release --test
 //! translucent`). Heavier versions, ≈ 1.5 min: `cargo test --release --test translucent --
-//! --ignored --nocapture`; of those, `furnace_default_tables_full` fails by design (see
-//! [`furnace`]).
+//! --ignored --nocapture` (`furnace_default_tables_full` is the rough furnace with the tables a
+//! recipe builds; see [`furnace`], finding 2).
 
 mod common;
 

@@ -39,23 +39,19 @@
 //! moved back to that offset, 0 leaks in the same 100 000 paths);
 //! [`a_scattering_point_on_the_boundary_does_not_leak`] pins the path.
 //!
-//! **Finding 2 (not fixed): compensation-table noise.** The compensated boundary's lobe returns
-//! `1 − E(μ)` of single-scattering albedos tabulated by Monte Carlo (64 entries of 4 096
-//! stratified samples, `RoughDielectric::with_energy_tables`); each entry's noise (the albedo
-//! `R + T` of the compensated interface is off 1 by up to ±0.2 %, e.g. +0.0020 ± 0.0002 at
-//! μ 0.6 from below, η 1.55, m 10°) shows in a furnace. Over 1 048 576 paths per configuration
-//! the rough clear bodies give 1.000 56 ± 0.000 36 (η 1.3, m 10°), 1.000 64 ± 0.000 47 (η 1.55,
-//! m 10°) and 1.003 54 ± 0.000 94 (η 2.4, m 10°, z 3.8: fails), and over 4 194 304 paths at
-//! α 0.2, 1.000 56 ± 0.000 19 (η 1.3) and 1.001 60 ± 0.000 49 (η 2.4). With tables of 128² · 4
-//! samples per entry the same bodies give 0.999 87 ± 0.000 36, 0.999 47 ± 0.000 47 and
-//! 1.001 40 ± 0.000 92 (and 0.999 88 ± 0.000 19, 0.999 69 ± 0.000 48 at α 0.2), and tables of
-//! the default size built from other random numbers 0.999 86 ± 0.000 19 and 1.000 41 ± 0.000 48
-//! at α 0.2: the excess is the particular noise of the default tables, not the integrator or the
-//! media. [`furnace_full`] (1 048 576 paths per configuration, rough boundaries with 128² · 4-sample
-//! tables; ≈ 30 s) passes; [`furnace_default_tables_full`] (the rough clear bodies with the default
-//! tables) fails by design. At CI counts the excess is below the noise. (The precise tables leave
-//! ≤ 0.06 % deficits, e.g. −0.000 33 ± 0.000 04 at μ 0.95 from above: linear interpolation
-//! between the 64 entries.)
+//! **Finding 2 (fixed): compensation-table noise.** The compensated boundary's lobe returns
+//! `1 − E(μ)` of single-scattering albedos tabulated by stratified Monte Carlo; with the coats'
+//! 64 entries of 4 096 samples (`RoughDielectric::with_energy_tables`) each entry's noise (the
+//! albedo `R + T` of the compensated interface off 1 by up to ±0.2 %, e.g. +0.0020 ± 0.0002 at
+//! μ 0.6 from below, η 1.55, m 10°) showed in a furnace, since light meets a stone's boundary
+//! many times: over 1 048 576 paths per configuration 1.000 56 ± 0.000 36 (η 1.3, m 10°),
+//! 1.000 64 ± 0.000 47 (η 1.55) and 1.003 54 ± 0.000 94 (η 2.4, z 3.8: failed). A body's
+//! boundary now uses 16 384 samples per entry (`scene::body::BOUNDARY_GRID` = 64): the same run
+//! gives 0.999 83 ± 0.000 36, 0.999 54 ± 0.000 47 and 1.002 10 ± 0.000 93 (α 0.5: 0.999 51,
+//! 0.998 83, 0.998 54), and passes ([`furnace_default_tables_full`], ≈ 20 s). With 128² · 4
+//! samples per entry ([`furnace_full`]) the bodies give 0.999 87 ± 0.000 36, 0.999 47 ± 0.000 47
+//! and 1.001 40 ± 0.000 92. (Those precise tables still leave ≤ 0.06 % deficits, e.g.
+//! −0.000 33 ± 0.000 04 at μ 0.95 from above: linear interpolation between the 64 entries.)
 
 use super::{Acc, build, gem, z_limit};
 use lapidary::bsdf::{Bsdf, RoughDielectric};
@@ -150,7 +146,7 @@ struct Outcome {
 /// Which boundary replaces the recipe's for a run.
 #[derive(Clone, Copy, PartialEq, Eq)]
 enum Boundary {
-    /// As the recipe builds it (`with_energy_tables`).
+    /// As the recipe builds it (`with_energy_tables_at(BOUNDARY_GRID)`).
     Recipe,
     /// Rough boundaries with compensation tables of `PRECISE_GRID² · 4` samples per entry.
     Precise,
@@ -346,12 +342,10 @@ fn furnace_full() {
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
-/// The rough clear bodies at 1 048 576 paths with the boundary exactly as a recipe builds it.
-/// Expected to FAIL (η 2.4, m 10°: 1.003 54 ± 0.000 94): the default compensation tables' noise
-/// gives a furnace excess of 0.05–0.35 % (module docs), not resolved at CI counts.
+/// The rough clear bodies at 1 048 576 paths with the boundary exactly as a recipe builds it
+/// (`BOUNDARY_GRID` tables; module docs, finding 2).
 #[test]
-#[ignore = "known failure: noise of the default compensation tables (RoughDielectric::with_energy_tables, \
-            4 096 samples per entry) gives the rough furnace +0.05…0.35 %; see tests/translucent/furnace.rs"]
+#[ignore = "slow: cargo test --release --test translucent -- --ignored furnace_default_tables_full"]
 fn furnace_default_tables_full() {
     let c: Vec<Config> = configs()
         .into_iter()
