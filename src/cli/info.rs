@@ -108,7 +108,7 @@ pub fn describe(recipe: &GemRecipe, scene: &Scene, points: u32) -> String {
         o,
         "\nmaterials ({}, {} used):",
         s.names.len(),
-        s.used.iter().filter(|u| **u).count()
+        s.names.len() - s.unused().count()
     );
     let width = s.names.iter().map(|n| n.len()).max().unwrap_or(4).max(4);
     let _ = writeln!(
@@ -129,7 +129,13 @@ pub fn describe(recipe: &GemRecipe, scene: &Scene, points: u32) -> String {
             "  {i:>3}  {name:<width$}  {:>6.2}%  {:<10}  {coats:<28}  {base}{own}{}",
             100.0 * f64::from(counts[i]) / f64::from(points),
             format!("{:#}", s.stacks[i].model),
-            if s.used[i] { "" } else { "  (unused)" }
+            if s.used[i] {
+                ""
+            } else if s.unused().any(|n| n == name) {
+                "  (unused)"
+            } else {
+                "  (platelets)"
+            }
         );
     }
     if let Some(b) = &s.body {
@@ -153,6 +159,28 @@ pub fn describe(recipe: &GemRecipe, scene: &Scene, points: u32) -> String {
             100.0 * f64::from(counts[i]) / f64::from(points),
             b.ior
         );
+        for (k, p) in b.platelets.iter().enumerate() {
+            let orient = match p.orientation {
+                crate::platelet::Orientation::Uniform => "random orientation".to_string(),
+                crate::platelet::Orientation::Aligned { axis, spread } => format!(
+                    "aligned to {:.3?} within {:.1}°",
+                    axis.to_array(),
+                    spread.to_degrees()
+                ),
+            };
+            let names: Vec<&str> = p.entries.iter().map(|e| s.name(e.1)).collect();
+            let _ = writeln!(
+                o,
+                "       platelets[{k}]: {} per unit³, radius {} … {}, {orient}; cells {:.4} \
+                 ({:.2} per cell); faces {}",
+                p.density,
+                p.radius.0,
+                p.radius.1,
+                p.cell,
+                p.mean_per_cell,
+                names.join(", ")
+            );
+        }
     }
 
     // Map statistics.
