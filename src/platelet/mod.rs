@@ -17,6 +17,7 @@
 //! with `(n + ik)/n_host`).
 
 pub mod grid;
+pub mod statistical;
 
 use crate::sampler::{Rng, hash_words};
 use glam::Vec3;

@@ -227,6 +227,9 @@ pub(crate) fn stage(
     rs.max_depth = rd.max_depth.unwrap_or(rs.max_depth);
     rs.medium_depth = rd.medium_depth.unwrap_or(rs.medium_depth);
     rs.medium_scattering = rd.medium_scattering.unwrap_or(rs.medium_scattering);
+    if let Some(f) = rd.platelets {
+        rs.platelets_explicit = f == super::stage::PlateletForm::Explicit;
+    }
     rs.exposure = rd.exposure.unwrap_or(rs.exposure);
     rs.seed = rd.seed.unwrap_or(rs.seed);
     if let Some(s) = rd.sampler {

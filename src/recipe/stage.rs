@@ -239,6 +239,15 @@ pub struct TransformDesc {
     pub scale: f32,
 }
 
+/// How platelets are traced.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum PlateletForm {
+    /// Disc by disc.
+    Explicit,
+    /// As a medium of oriented flakes.
+    Statistical,
+}
+
 /// The floor.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -433,6 +442,10 @@ pub struct RenderDesc {
     /// Whether a body's medium scatters (default true; false: absorption only).
     #[serde(default)]
     pub medium_scattering: Option<bool>,
+    /// How a body's platelets are traced: `Explicit` (default, disc by disc) or `Statistical`
+    /// (as a medium of oriented flakes).
+    #[serde(default)]
+    pub platelets: Option<PlateletForm>,
     /// The sampler.
     #[serde(default)]
     pub sampler: Option<SamplerDesc>,

@@ -103,6 +103,25 @@ where
                 found = Some(h);
             }
         }
+        if let Some(flakes) = &world.flakes
+            && path.medium == world.interior
+        {
+            let t_max = found.as_ref().map_or(f32::INFINITY, Hit::t);
+            let u = sampler.get2d_at(slots::platelet(path.depth));
+            if let Some(c) = flakes.collide(ray.dir, t_max, u) {
+                found = Some(Hit::Platelet {
+                    t: c.t,
+                    p: ray.at(c.t),
+                    n: c.normal,
+                    material: c.material,
+                    id: crate::platelet::PlateletId {
+                        population: u32::MAX,
+                        cell: [0; 3],
+                        index: 0,
+                    },
+                });
+            }
+        }
         if world.medium {
             let medium = &world.media[usize::from(path.medium.0)];
             let t_hit = found.as_ref().map_or(f32::INFINITY, Hit::t);

@@ -163,6 +163,9 @@ pub struct World {
     /// Platelet populations inside the body (object space), walked on every segment inside it
     /// when the `platelets` effect is on.
     pub platelets: Vec<crate::platelet::Population>,
+    /// The platelets' statistical form (`platelets: statistical`): a medium of flakes instead of
+    /// [`World::platelets`].
+    pub flakes: Option<crate::platelet::statistical::FlakeMedium>,
     /// Whether the free-flight code runs on every segment (the `medium` effect): a body with an
     /// absorbing or scattering interior, or the effect forced on.
     pub medium: bool,
@@ -381,8 +384,28 @@ impl World {
             medium_depth: stage.render.medium_depth,
             transmission_off: scene.effects.forced(Effect::Transmission) == Some(false),
             platelets: match body {
-                Some(b) if shows_body && scene.effects.on(Effect::Platelets) => b.platelets.clone(),
+                Some(b)
+                    if shows_body
+                        && scene.effects.on(Effect::Platelets)
+                        && stage.render.platelets_explicit =>
+                {
+                    b.platelets.clone()
+                }
                 _ => vec![],
+            },
+            flakes: match body {
+                Some(b)
+                    if shows_body
+                        && scene.effects.on(Effect::Platelets)
+                        && !stage.render.platelets_explicit
+                        && !b.platelets.is_empty() =>
+                {
+                    Some(crate::platelet::statistical::FlakeMedium::new(
+                        &b.platelets,
+                        stage.to_world,
+                    ))
+                }
+                _ => None,
             },
             medium: medium_on,
             map: scene.surface.map.with_effects(MapEffects {

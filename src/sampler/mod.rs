@@ -63,6 +63,18 @@ pub mod slots {
         };
         WAVELENGTH + 1 + b
     }
+
+    /// The statistical-platelet slot of the segment before bounce `b` (issue 18): a collision
+    /// distance and a platelet normal, read without moving the counter.
+    #[inline]
+    pub const fn platelet(b: u32) -> u32 {
+        let b = if b < MEDIUM_BOUNCES {
+            b
+        } else {
+            MEDIUM_BOUNCES - 1
+        };
+        WAVELENGTH + 1 + MEDIUM_BOUNCES + b
+    }
 }
 
 pub use pixel::{PixelSampler, SamplerKind};

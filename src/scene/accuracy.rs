@@ -263,6 +263,8 @@ pub struct Knobs {
     pub medium_depth: Option<u32>,
     /// Whether media scatter (`None`: the recipe's).
     pub medium_scattering: Option<bool>,
+    /// Platelets explicit (`true`) or statistical (`None`: the recipe's).
+    pub platelets_explicit: Option<bool>,
 }
 
 impl Knobs {
@@ -301,6 +303,14 @@ impl Knobs {
                 })?;
                 self.medium_depth = Some(d);
             }
+            "platelets"
+                if matches!(
+                    value.to_ascii_lowercase().as_str(),
+                    "explicit" | "statistical"
+                ) =>
+            {
+                self.platelets_explicit = Some(value.eq_ignore_ascii_case("explicit"));
+            }
             "medium-scattering" | "medium_scattering" => {
                 self.medium_scattering = Some(parse_switch("medium-scattering", value)?);
             }
@@ -323,6 +333,9 @@ impl Knobs {
         }
         if let Some(s) = self.medium_scattering {
             scene.stage.render.medium_scattering = s;
+        }
+        if let Some(e) = self.platelets_explicit {
+            scene.stage.render.platelets_explicit = e;
         }
         scene.set_accuracy(&self.accuracy, by)
     }
@@ -370,6 +383,12 @@ impl fmt::Display for Knobs {
             parts.push(format!(
                 "medium-scattering={}",
                 if s { "on" } else { "off" }
+            ));
+        }
+        if let Some(e) = self.platelets_explicit {
+            parts.push(format!(
+                "platelets={}",
+                if e { "explicit" } else { "statistical" }
             ));
         }
         if parts.is_empty() {

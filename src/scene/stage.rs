@@ -178,6 +178,8 @@ pub struct RenderSettings {
     /// Whether media scatter (`medium-scattering=off`: the absorption-only approximation, where
     /// light that would scatter goes straight on).
     pub medium_scattering: bool,
+    /// Platelets traced one by one (`false`: their statistical form, a medium of flakes).
+    pub platelets_explicit: bool,
     /// The sampler.
     pub sampler: SamplerKind,
     /// The pixel filter.
@@ -302,6 +304,7 @@ impl Stage {
                 max_depth: 8,
                 medium_depth: DEFAULT_MEDIUM_DEPTH,
                 medium_scattering: true,
+                platelets_explicit: true,
                 sampler: SamplerKind::Sobol,
                 filter: Filter::Gaussian { radius: 1.5 },
                 exposure: 0.0,
