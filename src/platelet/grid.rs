@@ -50,8 +50,9 @@ fn hit_disc(
     (q.length_squared() <= radius * radius).then_some(t)
 }
 
-/// One population's walk: the first cell along the segment that holds a hit holds the nearest
-/// (a disc never leaves its cell).
+/// One population's walk: in each cell along the segment, the discs of the cell and of the
+/// neighbours within `r_max` of the segment's part in it; hits are kept only inside the cell, so
+/// the first cell with one holds the nearest.
 fn walk(
     pop: &Population,
     index: u32,
@@ -65,6 +66,7 @@ fn walk(
         return None;
     }
     let cell = pop.cell;
+    let reach = pop.radius.1;
     let start = o + d * t_min;
     let mut c = (start / cell).floor();
     let step = d.signum();
@@ -80,31 +82,56 @@ fn walk(
             t_delta[a] = cell / d[a].abs();
         }
     }
+    let mut t_enter = t_min;
     for _ in 0..MAX_CELLS {
-        let ci = [c.x as i32, c.y as i32, c.z as i32];
+        let t_exit = t_next.min_element().min(t_max);
+        // The segment's part in this cell, and the neighbours it comes within `reach` of.
+        let (p0, p1) = (o + d * t_enter, o + d * t_exit);
+        let (lo, hi) = (p0.min(p1), p0.max(p1));
+        let low = c * cell;
+        let mut range = [[0i32; 2]; 3];
+        for a in 0..3 {
+            range[a][0] = if lo[a] - low[a] < reach { -1 } else { 0 };
+            range[a][1] = if low[a] + cell - hi[a] < reach { 1 } else { 0 };
+        }
         let mut found: Option<PlateletHit> = None;
-        pop.each_in_cell(ci, |k, p| {
-            let id = PlateletId {
-                population: index,
-                cell: ci,
-                index: k,
-            };
-            if skip == Some(id) {
-                return false;
+        for dx in range[0][0]..=range[0][1] {
+            for dy in range[1][0]..=range[1][1] {
+                for dz in range[2][0]..=range[2][1] {
+                    let ci = [c.x as i32 + dx, c.y as i32 + dy, c.z as i32 + dz];
+                    pop.each_in_cell(ci, |k, p| {
+                        let id = PlateletId {
+                            population: index,
+                            cell: ci,
+                            index: k,
+                        };
+                        if skip == Some(id) {
+                            return false;
+                        }
+                        // Hits inside this cell only: `t_enter ≤ t ≤ t_exit`.
+                        let lo_t = t_enter.max(t_min);
+                        let hi_t = found.map_or(t_exit, |h| h.t);
+                        if let Some(t) =
+                            hit_disc(p.center, p.normal, p.radius, o, d, lo_t, hi_t * 1.000_001)
+                            && t <= hi_t.max(lo_t)
+                        {
+                            found = Some(PlateletHit {
+                                t,
+                                normal: p.normal,
+                                material: p.material,
+                                id,
+                            });
+                        }
+                        false
+                    });
+                }
             }
-            let limit = found.map_or(t_max, |h| h.t);
-            if let Some(t) = hit_disc(p.center, p.normal, p.radius, o, d, t_min, limit) {
-                found = Some(PlateletHit {
-                    t,
-                    normal: p.normal,
-                    material: p.material,
-                    id,
-                });
-            }
-            false
-        });
+        }
         if found.is_some() {
             return found;
+        }
+        if t_exit >= t_max {
+            return None;
         }
         let a = if t_next.x <= t_next.y && t_next.x <= t_next.z {
             0
@@ -113,9 +140,7 @@ fn walk(
         } else {
             2
         };
-        if t_next[a] >= t_max {
-            return None;
-        }
+        t_enter = t_next[a];
         c[a] += step[a];
         t_next[a] += t_delta[a];
     }
@@ -144,8 +169,9 @@ mod tests {
             let walked = intersect(std::slice::from_ref(&pop), o, d, 0.0, t_max, None);
             // Brute force over the cells of the segment's bounding box.
             let (a, b) = (o, o + d * t_max);
-            let lo = (a.min(b) / pop.cell).floor();
-            let hi = (a.max(b) / pop.cell).floor();
+            // Discs reach one cell beyond their own.
+            let lo = (a.min(b) / pop.cell).floor() - 1.0;
+            let hi = (a.max(b) / pop.cell).floor() + 1.0;
             let mut best: Option<f32> = None;
             for x in lo.x as i32..=hi.x as i32 {
                 for y in lo.y as i32..=hi.y as i32 {

@@ -2,13 +2,16 @@
 //!
 //! A [`Population`] is a 3-D jittered point process on a cubic grid of cells (object space): the
 //! platelets of a cell are a pure function of `(seed, cell)` — a Poisson number of discs, each with a
-//! centre, radius, normal and material entry drawn from a stream keyed by the cell — generated when
-//! a ray visits the cell and never stored for the whole stone ([`grid`]). A disc lies entirely
-//! inside its cell (its centre is kept `r` away from the cell's faces), so a ray that walks the cells
-//! in order (a 3-D DDA, Amanatides & Woo, "A Fast Voxel Traversal Algorithm for Ray Tracing",
-//! Eurographics 1987) finds the nearest disc in the first cell where it finds any. Discs are
-//! two-sided and hit exactly (ray–plane, then the radius); the boundary clips them, since only the
-//! segment inside the body is walked.
+//! centre uniform in the cell, radius, normal and material entry drawn from a stream keyed by the
+//! cell — generated when a ray visits the cell and never stored for the whole stone ([`grid`]).
+//! Cells are at least `2.2 r_max` wide, so a disc reaches at most into the 26 neighbours of its
+//! cell. A ray walks the cells in order (a 3-D DDA, Amanatides & Woo, "A Fast Voxel Traversal
+//! Algorithm for Ray Tracing", Eurographics 1987); in each cell it tests the discs of that cell and
+//! of the neighbours its segment comes within `r_max` of, and keeps only hits inside the cell, so
+//! the first cell with a hit holds the nearest. Discs are two-sided and hit exactly (ray–plane,
+//! then the radius); the boundary clips them, since only the segment inside the body is walked.
+//! (An earlier version kept each disc inside its own cell instead: that leaves slabs near the
+//! cell faces with fewer platelets, visible as stripes.)
 //!
 //! Orientation: uniform over the sphere (goldstone's randomly oriented copper crystals), or
 //! aligned — the normal uniform in a cone of half-angle `spread` about an axis (Oregon sunstone's
@@ -101,8 +104,8 @@ pub struct PlateletHit {
 }
 
 impl Population {
-    /// A population with its grid chosen: cells at least `2.2 r_max` wide (a disc fits in its
-    /// cell) and about [`TARGET_PER_CELL`] platelets per cell where the platelets are small.
+    /// A population with its grid chosen: cells at least `2.2 r_max` wide (a disc reaches no
+    /// further than the next cell) and about [`TARGET_PER_CELL`] platelets per cell where the platelets are small.
     /// `None` if the result would put more than [`MAX_MEAN_PER_CELL`] platelets in a cell on
     /// average (the platelets would overlap heavily; the recipe compiler reports it).
     pub fn new(
@@ -151,10 +154,8 @@ impl Population {
         let origin = Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32) * self.cell;
         for index in 0..n {
             let radius = self.radius.0 + (self.radius.1 - self.radius.0) * rng.uniform();
-            let room = (self.cell - 2.0 * radius).max(0.0);
-            let center = origin
-                + Vec3::splat(radius)
-                + Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * room;
+            let center =
+                origin + Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * self.cell;
             let normal = self.orientation.sample(rng.uniform(), rng.uniform());
             let u = rng.uniform();
             let material = self
@@ -233,7 +234,7 @@ mod tests {
     }
 
     #[test]
-    fn platelets_stay_in_their_cell_and_are_reproducible() {
+    fn centres_lie_in_their_cell_and_are_reproducible() {
         let pop = Population::new(
             50.0,
             (0.01, 0.05),
@@ -250,8 +251,9 @@ mod tests {
             assert_eq!(a, b);
             let lo = Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32) * pop.cell;
             for p in &a {
-                assert!((p.center - p.radius - lo).min_element() >= -1e-5);
-                assert!((lo + pop.cell - p.center - p.radius).min_element() >= -1e-5);
+                assert!((p.center - lo).min_element() >= -1e-5);
+                assert!((lo + pop.cell - p.center).min_element() >= -1e-5);
+                assert!(p.radius >= 0.01 && p.radius <= 0.05);
                 assert!((p.normal.length() - 1.0).abs() < 1e-4);
                 assert!(p.material == 3 || p.material == 4);
             }

@@ -27,7 +27,10 @@ pub(crate) fn stage(
     effects: &mut Effects,
     errors: &mut Vec<RecipeError>,
 ) -> Option<Stage> {
-    let mut stage = Stage::studio();
+    let mut stage = match r.content.stage.as_ref().and_then(|s| s.preset) {
+        Some(super::stage::StagePreset::Jeweller) => Stage::jeweller(),
+        _ => Stage::studio(),
+    };
     let n_errors = errors.len();
     let src = &r.source;
     let stage_at = src.find(&["stage", ":"]);

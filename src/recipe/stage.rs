@@ -160,6 +160,10 @@ fn grey_half() -> ColorDesc {
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct StageDesc {
+    /// The built-in stage the recipe's parts replace parts of: `Studio` (default) or `Jeweller`
+    /// (a close-up light tent with one small hard light, for sparkle at depth).
+    #[serde(default)]
+    pub preset: Option<StagePreset>,
     /// The stone's shape (object space; the surface maps are evaluated there).
     #[serde(default)]
     pub shape: Option<ShapeDesc>,
@@ -237,6 +241,15 @@ pub struct TransformDesc {
     /// Uniform scale, 0 <.. 1e4 (default 1).
     #[serde(default = "one", deserialize_with = "factor_range")]
     pub scale: f32,
+}
+
+/// A built-in stage.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum StagePreset {
+    /// Three soft boxes, a dim sky, a grey floor, a camera 30° down.
+    Studio,
+    /// A light tent: bright walls, two soft boxes, one small hard light, a macro camera.
+    Jeweller,
 }
 
 /// How platelets are traced.

@@ -244,6 +244,62 @@ pub fn placement(scale: f32, rotate_deg: Vec3, translate: Vec3) -> Affine3A {
 }
 
 impl Stage {
+    /// The jeweller's stage (issue 18): a close-up light tent for sparkle at depth — bright
+    /// tent walls (a bright gradient sky), a white floor, two large soft boxes left and right and
+    /// one small, hard disc light above and behind the camera, and a macro camera close to the
+    /// studio cabochon (22° field of view). What a jeweller's loupe photograph shows: glitter
+    /// beneath the surface catches the small light; the soft boxes show the body colour.
+    pub fn jeweller() -> Stage {
+        let studio = Stage::studio();
+        let target = Vec3::new(0.0, 0.25, 0.0);
+        let camera = Camera::look_at(
+            Vec3::new(0.0, 1.9, 2.6),
+            target,
+            Vec3::Y,
+            Projection::Perspective {
+                fov: 22f32.to_radians(),
+                aperture: 0.0,
+                focus_distance: (Vec3::new(0.0, 1.9, 2.6) - target).length(),
+            },
+        )
+        .expect("the jeweller's camera is well defined");
+        let small = Vec3::new(0.8, 4.5, 3.0);
+        Stage {
+            ground: Some(Ground {
+                height: 0.0,
+                albedo: Rgb::splat(0.7),
+            }),
+            environment: Environment::Gradient {
+                zenith: Rgb::splat(0.9),
+                horizon: Rgb::splat(0.6),
+                nadir: Rgb::splat(0.3),
+            },
+            lights: vec![
+                rect_light(
+                    Vec3::new(-3.0, 2.5, 0.5),
+                    target,
+                    (3.0, 3.0),
+                    Rgb::splat(2.5),
+                ),
+                rect_light(
+                    Vec3::new(3.0, 2.5, 0.5),
+                    target,
+                    (3.0, 3.0),
+                    Rgb::splat(2.0),
+                ),
+                AreaLight {
+                    center: small,
+                    normal: (target - small).normalize(),
+                    shape: LightShape::Disc { radius: 0.06 },
+                    radiance: Rgb::splat(2500.0),
+                    two_sided: false,
+                },
+            ],
+            camera,
+            ..studio
+        }
+    }
+
     /// The built-in studio: an elliptical cabochon (2 × 1.6 units, 0.55 high) on a grey floor,
     /// three soft boxes (key upper left, fill right, rim behind), a dim sky gradient and a camera
     /// looking down at 30°.
