@@ -91,7 +91,7 @@ fn rows() -> Vec<Row> {
         row("missing_comma", (3, 4), &["Expected comma"], gem(" surface: Voronoi(scale: 0.1\n   fill: 0.5, entries: [(1.0, Material(\"a\"))])")),
         row("unclosed_paren", (2, 41), &["Expected comma"], s("(materials: {\n \"c\": (coats: [(ior: 1.5, roughness: 1.0], base: Lambert(albedo: Gray(0.5))),\n},\n surface: Material(\"c\"))")),
         row("unclosed_paren_at_eof", (2, 60), &["Expected comma", "the `(` at 2:18 is never closed"], s(M) + "\n surface: Overlay(under: Material(\"a\"), over: Material(\"b\")\n"),
-        row("unknown_top_field", (2, 2), &["`colour`", "`seed`, `include`, `materials`, `maps`, `surface`, or `stage`"], gem(" colour: 1,\n surface: Material(\"a\")")),
+        row("unknown_top_field", (2, 2), &["`colour`", "`seed`, `include`, `materials`, `maps`, `body`, `surface`, or `stage`"], gem(" colour: 1,\n surface: Material(\"a\")")),
         row("unknown_field_voronoi", (3, 4), &["`size` in `Voronoi`", "`scale`", "`entries`", "`fill`"], gem(" surface: Voronoi(scale: 0.1,\n   size: 2.0, entries: [(1.0, Material(\"a\"))])")),
         row("unknown_field_coat", (3, 66), &["`colour` in `CoatDesc`", "`ior`", "`tint`"], coat("ior: 1.5, roughness: 1.0, colour: 1")),
         row("unknown_field_stage", (4, 3), &["`lighting` in `StageDesc`", "`lights`", "`camera`"], stage("  lighting: [],")),
