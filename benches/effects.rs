@@ -9,7 +9,9 @@
 //! change the model, so that is not an on-demand comparison), nested Voronoi maps without a bump
 //! for `facet-bump`, a hard marble switch for `glitter-overlay` and `stochastic-switch`, the
 //! studio's pinhole camera for `depth-of-field`, a gradient sky as the only light for
-//! `environment-importance`. Each is 64 × 48 pixels, 16 spp, Sobol', max depth 8
+//! `environment-importance`, and the shipped opaque gem `gems/sunstone.ron` for `transmission` and
+//! `medium` (issue 17: forced on, the free-flight code runs on every segment through a medium that
+//! neither absorbs nor scatters). Each is 64 × 48 pixels, 16 spp, Sobol', max depth 8
 //! (`LAPIDARY_BENCH_SIZE=W` renders W × 3W/4), on one worker thread; the world is built outside
 //! the timed closure.
 //!
@@ -39,9 +41,25 @@ fn width() -> u32 {
 }
 
 fn compile(text: &str) -> Scene {
-    let mut s = GemRecipe::parse("effects-bench.ron", text)
+    let s = GemRecipe::parse("effects-bench.ron", text)
         .and_then(|r| r.compile())
         .unwrap_or_else(|e| panic!("the bench scene compiles: {e}"));
+    shrink(s)
+}
+
+/// A shipped gem from `gems/`.
+fn gem(name: &str) -> Scene {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("gems")
+        .join(name);
+    let s = GemRecipe::load(&path)
+        .and_then(|r| r.compile())
+        .unwrap_or_else(|e| panic!("{name} compiles: {e}"));
+    shrink(s)
+}
+
+/// The bench's size, spp, depth and sampler.
+fn shrink(mut s: Scene) -> Scene {
     let r = &mut s.stage.render;
     r.width = width();
     r.height = width() * 3 / 4;
@@ -101,6 +119,8 @@ fn scenes() -> Vec<(Effect, Scene)> {
         (Effect::StochasticSwitch, compile(&hard_switch)),
         (Effect::DepthOfField, compile(&bare)),
         (Effect::EnvironmentImportance, compile(sky)),
+        (Effect::Transmission, gem("sunstone.ron")),
+        (Effect::Medium, gem("sunstone.ron")),
     ]
 }
 

@@ -3,7 +3,8 @@
 //! independent sampler, seed 7).
 //!
 //! - a uniform 2 % shift of every scene fails;
-//! - a 5 % shift of one material's pixels (selected by `material.Y`) fails;
+//! - a 5 % shift of one material's pixels (selected by `material.Y`) fails wherever the noise
+//!   lets it stand 2 above the limit (every opaque gem's material, some of the translucent ones');
 //! - a changed coat IOR (the recipe's text edited) fails;
 //! - two independent renders of every scene (seeds 7 and 8, neither the reference) pass;
 //! - over seeded pairs of independent renders, the false-failure rate is at most the stated
@@ -159,6 +160,27 @@ fn materials(img: &ExrImage) -> Vec<(i32, usize)> {
     v
 }
 
+/// The |z| a 5 % shift of material `m`'s pixels (by the reference's labels) would score at the
+/// material scale if the renders had no noise: per channel `0.05 Σ t / √Σ (var_t + var_r)` over
+/// the material's pixels, the largest channel.
+fn expected_z(test: &ExrImage, reference: &ExrImage, m: i32) -> f64 {
+    let labels = reference.channel("material.Y").unwrap();
+    ["R", "G", "B"]
+        .iter()
+        .map(|c| {
+            let t = test.channel(c).unwrap();
+            let vt = test.channel(&format!("variance.{c}")).unwrap();
+            let vr = reference.channel(&format!("variance.{c}")).unwrap();
+            let (mut sum, mut var) = (0.0f64, 0.0f64);
+            for i in (0..labels.len()).filter(|&i| labels[i] as i32 == m) {
+                sum += f64::from(t[i]);
+                var += f64::from(vt[i]) + f64::from(vr[i]);
+            }
+            0.05 * sum / var.sqrt()
+        })
+        .fold(0.0, f64::max)
+}
+
 #[test]
 fn a_five_percent_shift_of_one_material_fails() {
     // On every gem with more than one material, each material covering ≥ 2 % of the image
@@ -168,6 +190,14 @@ fn a_five_percent_shift_of_one_material_fails() {
     // (The test render's own labels agree with the reference's on only about half of an
     // aventurine's stone pixels — the first sample's material is itself random there — so a
     // shift selected by them is diluted; it is printed, not asserted.)
+    //
+    // The failure is required wherever the renders' noise lets the shift stand out: where its
+    // noise-free |z| at the material scale is at least 2 above the scale's limit (a miss then has
+    // probability < 2.3 %; the renders are seeded, so the outcome is fixed). That holds for every
+    // material of the opaque gems (expected |z| 7.0–34.7). On the translucent gems (issue 17)
+    // light found only by BSDF sampling through the body makes the pixels several times noisier:
+    // at 256 spp the pink Sunstone's three glitter materials (5.0–5.6 against 5.8) and the
+    // Aventurine glass's body (5.5 against 6.0) are printed, not asserted.
     let mut tried = 0;
     for (name, [test, _]) in golden_pairs() {
         let reference = reference(name);
@@ -175,26 +205,41 @@ fn a_five_percent_shift_of_one_material_fails() {
         if list.len() < 2 {
             continue;
         }
+        let limit = compare(test, &reference)
+            .unwrap()
+            .ztest
+            .expect("the images carry variance")
+            .scales
+            .iter()
+            .find(|s| s.label() == "material")
+            .expect("a material scale")
+            .z_crit;
         let by_ref = reference.channel("material.Y").unwrap();
         let by_test = test.channel("material.Y").unwrap();
         for &(m, count) in list.iter().filter(|(_, n)| *n >= 184) {
             let c = compare(&shifted(test, 1.05, |i| by_ref[i] as i32 == m), &reference).unwrap();
             let own =
                 compare(&shifted(test, 1.05, |i| by_test[i] as i32 == m), &reference).unwrap();
+            let expected = expected_z(test, &reference, m);
+            let required = expected >= limit + 2.0;
             eprintln!(
-                "{name}, material {m} ({count} px) × 1.05: {}; selected by the test's labels: {}",
+                "{name}, material {m} ({count} px) × 1.05: expected |z| {expected:.2} (limit \
+                 {limit:.2}{}): {}; selected by the test's labels: {}",
+                if required { "" } else { ", not required" },
                 summary(&c),
                 if own.passed { "pass" } else { "FAIL" }
             );
-            assert!(
-                !c.passed,
-                "{name}: material {m} × 1.05 passed: {}",
-                summary(&c)
-            );
-            tried += 1;
+            if required {
+                assert!(
+                    !c.passed,
+                    "{name}: material {m} × 1.05 passed: {}",
+                    summary(&c)
+                );
+                tried += 1;
+            }
         }
     }
-    assert!(tried >= 20, "only {tried} materials tried");
+    assert!(tried >= 15, "only {tried} materials tried");
 }
 
 #[test]

@@ -12,25 +12,46 @@
 //! squared sums, AOV sums, counts, material ids, ray counts), which `PartialEq` on `f64` would not
 //! (it takes `-0.0 == 0.0`).
 //!
+//! Translucent bodies (issue 17): `transmission` (a body the surface shows) and `medium` (a body
+//! whose interior absorbs or scatters) are checked on the shipped opaque Sunstone (and, with every
+//! other effect, on the bare scene), each forced on and off alone and both together, on a recipe whose `body` the
+//! surface never shows, and — for `medium` — on clear bodies (no medium, a zero medium, a white
+//! colour), whose paths cross the boundary but need no free flight.
+//!
 //! Negative controls show the toggles are live: in a scene that calls for an effect, forcing it off
 //! changes the image (absorption, facet bump, glitter overlay, stochastic switch, depth of field,
-//! environment importance), and forcing the `t` term on in a coated Corrected scene changes it too —
-//! `t-term` is a model knob, not an on-demand effect, so its "scene that does not call for it" has
-//! no coats (or Reference-model coats). The three effects this version does not simulate
-//! (transmission, spectral, fluorescence) refuse to be forced on, naming "does not simulate" and
-//! leaving the scene unchanged, and forcing them off is a no-op.
+//! environment importance, transmission and medium on the translucent pink Sunstone), and forcing
+//! the `t` term on in a coated Corrected scene changes it too — `t-term` is a model knob, not an
+//! on-demand effect, so its "scene that does not call for it" has no coats (or Reference-model
+//! coats). The two effects this version does not simulate (spectral, fluorescence) refuse to be
+//! forced on, naming "does not simulate" and leaving the scene unchanged, and forcing them off is a
+//! no-op. The medium's knobs (`medium-depth`, `medium-scattering`) change a scattering body and
+//! leave an opaque gem bit-identical.
 //!
 //! Scenes are 48 × 36 pixels at 16 spp (Sobol') on the studio stage unless a test says otherwise.
 
 use lapidary::recipe::GemRecipe;
 use lapidary::render::{Control, Film, PixelSums, World, render};
 use lapidary::scene::{Accuracy, Effect, Knobs, Scene};
+use std::path::Path;
 
 /// Compiles recipe text and shrinks the render to 48 × 36 at 16 spp.
 fn scene(text: &str) -> Scene {
     let mut s = GemRecipe::parse("effects.ron", text)
         .unwrap_or_else(|e| panic!("{e}"))
         .compile()
+        .unwrap_or_else(|e| panic!("{e}"));
+    small(&mut s);
+    s
+}
+
+/// A shipped gem from `gems/`, shrunk like [`scene`].
+fn gem(name: &str) -> Scene {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("gems")
+        .join(name);
+    let mut s = GemRecipe::load(&path)
+        .and_then(|r| r.compile())
         .unwrap_or_else(|e| panic!("{e}"));
     small(&mut s);
     s
@@ -507,8 +528,11 @@ fn effects_this_version_does_not_simulate_cannot_be_forced_on() {
                         base: Lambert(albedo: Gray(0.6))),
                "vein": (coats: [(ior: 1.5, roughness: 4.0)], base: Lambert(albedo: Gray(0.9)), model: Course),
                "glitter": (base: Conductor(metal: Silver, roughness: 2.0)) },
+            body: (ior: 1.55, roughness: 3.0,
+                   medium: (colour: Srgb(0.9, 0.7, 0.6), distance: 1.0, scattering: (2.0, 2.0, 2.0))),
             surface: Overlay(
-                under: Switch(by: Marble(scale: 0.5), stops: [(0.0, Material("body")), (0.6, Material("vein"))],
+                under: Switch(by: Marble(scale: 0.5),
+                              stops: [(0.0, Material("body")), (0.3, Body), (0.6, Material("vein"))],
                               blend: 0.1),
                 over: Voronoi(scale: 0.06, fill: 0.1, entries: [(1.0, Material("glitter"))],
                               bump: Cone(half_angle: 20.0))),
@@ -518,8 +542,8 @@ fn effects_this_version_does_not_simulate_cannot_be_forced_on() {
     let called: Vec<Effect> = busy.effects.iter().collect();
     assert_eq!(
         called.len(),
-        6,
-        "the scene should call for six effects: {called:?}"
+        8,
+        "the scene should call for eight effects: {called:?}"
     );
     let auto = film(&busy);
     for effect in Effect::ALL.into_iter().filter(|e| !e.implemented()) {
@@ -538,10 +562,146 @@ fn effects_this_version_does_not_simulate_cannot_be_forced_on() {
         assert!(err.contains("does not simulate"), "{effect}: {err}");
         assert_eq!(s, busy);
 
-        assert_untouched(effect, "a scene calling for six other effects", &busy);
+        assert_untouched(effect, "a scene calling for eight other effects", &busy);
         let off = forced(&busy, effect, false);
         assert!(called.iter().all(|e| off.effects.on(*e)));
         let (n, first) = differences(&auto, &film(&off));
         assert_eq!(n, 0, "{effect} forced off: {}", first.unwrap_or_default());
+    }
+}
+
+/// `scene` with each `(effect, on)` of `states` forced at once.
+fn forced_all(scene: &Scene, states: &[(Effect, bool)]) -> Scene {
+    let mut s = scene.clone();
+    let mut acc = Accuracy::default();
+    for &(effect, on) in states {
+        acc.force(effect, on);
+    }
+    s.set_accuracy(&acc, "tests/effects.rs")
+        .unwrap_or_else(|e| panic!("forcing {states:?}: {e}"));
+    s
+}
+
+#[test]
+fn transmission_and_medium_code_change_nothing_for_opaque_gems() {
+    // The issue's claim for translucent bodies: an opaque gem renders bit-identically with the
+    // transmission and medium code forced on or off, alone and together (forced on, the
+    // free-flight code runs on every segment through a medium that neither absorbs nor scatters).
+    let mut failures = vec![];
+    for name in ["sunstone.ron"] {
+        let s = gem(name);
+        assert!(s.surface.body.is_none(), "{name} has a body");
+        for effect in [Effect::Transmission, Effect::Medium] {
+            failures.extend(untouched(effect, name, &s));
+        }
+        let auto = film(&s);
+        for on in [false, true] {
+            let both = forced_all(&s, &[(Effect::Transmission, on), (Effect::Medium, on)]);
+            assert_eq!(both.effects.on(Effect::Medium), on);
+            let (n, first) = differences(&auto, &film(&both));
+            if n > 0 {
+                failures.push(format!(
+                    "{name}: transmission and medium both forced {on}: {n} pixels differ; first at {}",
+                    first.unwrap_or_default()
+                ));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn a_body_the_surface_never_shows_changes_nothing() {
+    // The recipe has a `body` (with an absorbing, scattering medium), but the map never shows
+    // `Body`: the stone is opaque (a compile warning says so), nothing calls for transmission or
+    // the medium, and forcing either changes nothing.
+    let s = scene(&studio(
+        r#""clay": (coats: [(ior: 1.5, roughness: 2.0)], base: Lambert(albedo: Gray(0.6)))"#,
+        r#"Material("clay"),
+           body: (ior: 1.5, medium: (absorption: (1.0, 2.0, 3.0), scattering: (4.0, 4.0, 4.0)))"#,
+    ));
+    assert!(s.surface.body.is_some());
+    for effect in [Effect::Transmission, Effect::Medium] {
+        assert_untouched(effect, "a body the map never shows", &s);
+    }
+}
+
+#[test]
+fn medium_code_changes_nothing_for_clear_bodies() {
+    // Bodies the paths enter and leave, whose interior neither absorbs nor scatters: no medium,
+    // a medium of zero coefficients (a forward phase function that never acts), and a white
+    // colour (σa = −ln 1 = 0). Transmission is on; the free-flight code is not needed.
+    let mut failures = vec![];
+    for medium in [
+        "",
+        ", medium: (absorption: (0.0, 0.0, 0.0), phase: HenyeyGreenstein(g: 0.6))",
+        ", medium: (colour: Gray(1.0), distance: 0.5)",
+    ] {
+        let s = scene(&studio(
+            r#""flake": (coats: [(ior: 1.5, roughness: 3.0)], base: Conductor(metal: Copper, roughness: 4.0))"#,
+            &format!(
+                r#"Overlay(under: Body,
+                           over: Voronoi(scale: 0.08, fill: 0.2, entries: [(1.0, Material("flake"))])),
+                   body: (ior: 1.52, roughness: 2.0{medium}),
+                   stage: (transform: (translate: (0.0, 0.002, 0.0)))"#
+            ),
+        ));
+        assert!(s.effects.called(Effect::Transmission), "{medium}");
+        failures.extend(untouched(
+            Effect::Medium,
+            &format!("a clear body `{medium}`"),
+            &s,
+        ));
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn transmission_and_medium_forced_off_change_a_translucent_gem() {
+    // The pink Sunstone: glitter over a translucent, absorbing and scattering body. Forced off,
+    // transmission makes the boundary reflect only; the medium makes the interior clear.
+    let s = gem("sunstone-pink.ron");
+    assert_live(Effect::Transmission, "sunstone-pink", &s);
+    assert_live(Effect::Medium, "sunstone-pink", &s);
+    // Forcing them on where the scene calls for them changes nothing.
+    let auto = film(&s);
+    let on = forced_all(&s, &[(Effect::Transmission, true), (Effect::Medium, true)]);
+    let (n, first) = differences(&auto, &film(&on));
+    assert_eq!(n, 0, "forced on: {}", first.unwrap_or_default());
+}
+
+#[test]
+fn medium_knobs_change_a_scattering_body_and_nothing_else() {
+    // `medium-scattering=off` (absorption only) and a short `medium-depth` change the milky
+    // stone; on an opaque gem the same knobs change nothing.
+    let knobs = |text: &str, s: &Scene| {
+        let mut s = s.clone();
+        let k: Knobs = text.parse().unwrap();
+        k.apply(&mut s, "tests/effects.rs").unwrap();
+        s
+    };
+    let milky = gem("milky-stone.ron");
+    assert!(milky.effects.on(Effect::Medium));
+    let auto = film(&milky);
+    for setting in ["medium-scattering=off", "medium-depth=0", "medium-depth=4"] {
+        let (n, _) = differences(&auto, &film(&knobs(setting, &milky)));
+        eprintln!(
+            "milky stone, {setting}: {n} of {} pixels change",
+            auto.pixels.len()
+        );
+        assert!(
+            n >= 20,
+            "{setting} changed only {n} pixels of the milky stone"
+        );
+    }
+    let opaque = gem("sunstone.ron");
+    let auto = film(&opaque);
+    for setting in [
+        "medium-scattering=off",
+        "medium-depth=0",
+        "medium-depth=4096",
+    ] {
+        let (n, first) = differences(&auto, &film(&knobs(setting, &opaque)));
+        assert_eq!(n, 0, "{setting} on sunstone: {}", first.unwrap_or_default());
     }
 }

@@ -26,7 +26,7 @@ fn compile(text: &str) -> Scene {
 #[test]
 fn compiling_twice_gives_identical_tables() {
     let gems = shipped();
-    assert_eq!(gems.len(), 7, "{gems:?}");
+    assert_eq!(gems.len(), 9, "{gems:?}");
     let mut hashes = vec![];
     for path in gems {
         let a = GemRecipe::load(&path).unwrap().compile().unwrap();
@@ -36,7 +36,7 @@ fn compiling_twice_gives_identical_tables() {
     }
     hashes.sort_unstable();
     hashes.dedup();
-    assert_eq!(hashes.len(), 7, "every recipe hashes differently");
+    assert_eq!(hashes.len(), 9, "every recipe hashes differently");
 }
 
 #[test]
@@ -211,6 +211,77 @@ fn info_prints_materials_map_statistics_stage_and_effects() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains(":1:26: unknown material \"x\""), "{err}");
     let _ = std::fs::remove_file(&bad);
+}
+
+#[test]
+fn info_names_the_body_and_the_recipe_line_that_turned_transmission_and_medium_on() {
+    // The translucent gems: `transmission` and `medium` on, each naming the `body` line of the
+    // recipe, and the body's row in the material table; a forced effect names who forced it.
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let info = |args: &[&str]| {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_lapidary"))
+            .arg("info")
+            .args(args)
+            .current_dir(root)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8(out.stdout).unwrap()
+    };
+    for gem in [
+        "sunstone-pink",
+        "sunstone-patterned",
+        "aventurine-glass",
+        "tinted-glass-sphere",
+        "milky-stone",
+    ] {
+        let file = format!("gems/{gem}.ron");
+        let source = std::fs::read_to_string(root.join(&file)).unwrap();
+        // The line of the recipe's `body:` key (comments mention bodies too: skip them).
+        let line = 1 + source
+            .lines()
+            .position(|l| l.trim_start().starts_with("body:"))
+            .unwrap_or_else(|| panic!("{file} has no body"));
+        let text = info(&[&file]);
+        let transmission = format!("on   transmission             body ({file}:{line})");
+        let medium = format!("on   medium                   body ({file}:{line}) medium");
+        for expected in [
+            transmission.as_str(),
+            medium.as_str(),
+            "Body ",
+            "body: IOR ",
+        ] {
+            assert!(
+                text.contains(expected),
+                "{file}: missing {expected:?} in\n{text}"
+            );
+        }
+    }
+    // Forced off on the command line: `info` says who forced it.
+    let text = info(&[
+        "gems/milky-stone.ron",
+        "--effect",
+        "medium=off",
+        "--effect",
+        "transmission=off",
+    ]);
+    for effect in ["transmission", "medium"] {
+        let row = text
+            .split("\neffects:")
+            .nth(1)
+            .expect("an effects section")
+            .lines()
+            .find(|l| l.contains(&format!(" {effect} ")))
+            .unwrap_or_else(|| panic!("no {effect} row in\n{text}"));
+        assert!(
+            row.trim_start().starts_with("off") && row.contains("forced"),
+            "{effect}: {row}"
+        );
+    }
 }
 
 #[test]

@@ -68,7 +68,8 @@ pub struct TradeoffArgs {
     #[arg(long, default_value_t = 16, value_parser = parse_spp)]
     pub spp: u32,
     /// A knob setting `key=value,…` (repeatable; default: the built-in list, see the README).
-    /// Keys: model, fresnel, t-term, absorption, bump, sampler, max-depth and any effect name.
+    /// Keys: model, fresnel, distribution, masking, compensation, calibration, t-term, absorption,
+    /// bump, sampler, max-depth, medium-depth, medium-scattering and any effect name.
     #[arg(long = "setting")]
     pub settings: Vec<String>,
     /// Samples per pixel of the reference.
