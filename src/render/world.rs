@@ -326,9 +326,20 @@ impl World {
         } else {
             MediumId::OUTSIDE
         };
+        // A translucent stone resting on the floor: light leaving through its base starts within
+        // the spawn offset below the plane and would pass under the floor to the sky's nadir. The
+        // floor is lowered by 10⁻⁴ of the stone's size there, so that light meets it and the
+        // floor's light enters the base again (opaque stones keep the floor where it is).
+        let (stone_lo, stone_hi) = stone.bounds();
+        let size = (stone_hi - stone_lo).max_element().max(1e-6);
         let ground = stage.ground.map(|g| {
+            let resting = shows_body && (stone_lo.y - g.height).abs() <= 1e-3 * size;
             (
-                g.height,
+                if resting {
+                    g.height.min(stone_lo.y) - 1e-4 * size
+                } else {
+                    g.height
+                },
                 Bsdf::Lambert(Lambert {
                     albedo: g.albedo.into(),
                 }),
