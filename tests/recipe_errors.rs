@@ -82,6 +82,14 @@ fn nested_glitter(n: usize) -> String {
     ))
 }
 
+/// A body with two platelet populations from line 2: a valid one on line 3, then `second` from
+/// line 4 (the surface follows it).
+fn platelets(second: &str) -> String {
+    gem(&format!(
+        " body: (ior: 1.5, platelets: [\n  (density: 3000.0, radius: (0.01, 0.03), orientation: Uniform, entries: [(1.0, \"a\")]),\n  {second}]),\n surface: Body"
+    ))
+}
+
 fn rows() -> Vec<Row> {
     let s = |t: &str| t.to_string();
     #[rustfmt::skip]
@@ -167,6 +175,19 @@ fn rows() -> Vec<Row> {
         row("body_colour_without_distance", (3, 3), &["body.medium", "`colour` needs `distance`"], gem(" body: (ior: 1.5,\n  medium: (colour: Gray(0.5))),\n surface: Body")),
         row("body_g_one", (3, 39), &["phase g = 1", "-0.99 ..= 0.99"], gem(" body: (ior: 1.5,\n  medium: (phase: HenyeyGreenstein(g: 1.0))),\n surface: Body")),
         row("body_missing", (2, 11), &["`Body`", "no `body: (ior: …)`"], gem(" surface: Body")),
+        // --- Platelets (issue 18): numbers while parsing, at the value; the compiler's checks at
+        // the population's entry or `density` (the second population here, after a valid one).
+        row("platelets_density_zero", (5, 13), &["platelets.density = 0 ", "0 <.. 10000000"], platelets("(radius: (0.01, 0.03),\n   density: 0.0, orientation: Uniform, entries: [(1.0, \"a\")])")),
+        row("platelets_density_negative", (4, 35), &["platelets.density = -5", "0 <.. 10000000"], platelets("(radius: (0.01, 0.03), density: -5.0, orientation: Uniform, entries: [(1.0, \"a\")])")),
+        row("platelets_radius_reversed", (4, 29), &["platelets.radius = (0.03, 0.01)", "0 < smallest <= largest <= 1000"], platelets("(density: 3000.0, radius: (0.03, 0.01), orientation: Uniform, entries: [(1.0, \"a\")])")),
+        row("platelets_spread_120", (4, 95), &["spread = 120", "0 ..= 90"], platelets("(density: 3000.0, radius: (0.01, 0.03), orientation: Aligned(axis: (0.0, 1.0, 0.0), spread: 120.0), entries: [(1.0, \"a\")])")),
+        row("platelets_axis_zero", (4, 70), &["axis = (0.0, 0.0, 0.0)", "finite, non-zero direction"], platelets("(density: 3000.0, radius: (0.01, 0.03), orientation: Aligned(axis: (0.0, 0.0, 0.0), spread: 10.0), entries: [(1.0, \"a\")])")),
+        row("platelets_unknown_material", (4, 93), &["body.platelets[1]", "unknown material \"c\"", "layered materials"], platelets("(density: 3000.0, radius: (0.01, 0.03), orientation: Uniform, entries: [(1.0, \"a\"), (1.0, \"c\")])")),
+        row("platelets_weight_zero", (4, 88), &["entry weight = 0 ", "0 <.. 1000000"], platelets("(density: 3000.0, radius: (0.01, 0.03), orientation: Uniform, entries: [(1.0, \"a\"), (0.0, \"b\")])")),
+        row("platelets_entries_empty", (4, 75), &["list is empty"], platelets("(density: 3000.0, radius: (0.01, 0.03), orientation: Uniform, entries: [])")),
+        row("platelets_unknown_field", (4, 88), &["`size` in `PlateletsDesc`", "`density`", "`seed`"], platelets("(density: 3000.0, radius: (0.01, 0.03), orientation: Uniform, entries: [(1.0, \"a\")], size: 2.0)")),
+        row("platelets_too_dense", (5, 13), &["body.platelets[1]", "density 1000000 with radius up to 0.2", "more than 16 platelets", "overlap"], platelets("(radius: (0.1, 0.2), orientation: Uniform, entries: [(1.0, \"a\")],\n   density: 1000000.0)")),
+        row("platelets_under_ior_3_5", (3, 20), &["body.platelets[0]", "material \"b\" under the body", "outside_ior = 3.5", "1 ..= 3"], gem(" body: (ior: 3.5, platelets: [(density: 3000.0, radius: (0.01, 0.03), orientation: Uniform,\n   entries: [(1.0, \"b\"), (1.0, \"a\")])]),\n surface: Body")),
         row("light_target_is_center", (6, 4), &["stage.lights[1]", "`target` equals `center`"], stage("  lights: [\n   Rect(center: (0.0, 4.0, 0.0), size: (1.0, 1.0), radiance: Gray(1.0)),\n   Disc(center: (1.0, 2.0, 3.0), target: (1.0, 2.0, 3.0), radius: 1.0, radiance: Gray(1.0)),\n  ],")),
     ];
     rows
@@ -288,6 +309,44 @@ fn one_check_reports_every_error() {
         "positions not distinct: {all:#?}"
     );
     assert!(at.iter().all(|&(l, _)| l > 0), "{all:#?}");
+}
+
+/// Platelet errors point into the population they are about: two populations under a body of
+/// η 3.5 (beyond what a platelet face's layered model allows) both list material "a", one is too
+/// dense — each error at its own population's entry or `density` value.
+#[test]
+fn platelet_errors_point_into_their_population() {
+    let text = gem(
+        " body: (ior: 3.5, platelets: [\n  (density: 3000.0, radius: (0.01, 0.03), orientation: Uniform, entries: [(1.0, \"a\")]),\n  (radius: (0.1, 0.2), orientation: Uniform, entries: [(2.0, \"b\"), (1.0, \"a\")], density: 1e6)]),\n surface: Body",
+    );
+    let report = GemRecipe::check_source(Source::new("bad.ron", &text), None);
+    let all: Vec<String> = report.errors.iter().map(|e| e.to_string()).collect();
+    let expected: [(usize, usize, &[&str]); 4] = [
+        (
+            3,
+            81,
+            &["body.platelets[0]", "material \"a\" under the body"],
+        ),
+        (
+            4,
+            62,
+            &["body.platelets[1]", "material \"b\" under the body"],
+        ),
+        (
+            4,
+            74,
+            &["body.platelets[1]", "material \"a\" under the body"],
+        ),
+        (4, 90, &["body.platelets[1]", "density 1000000"]),
+    ];
+    for (line, col, msg) in expected {
+        assert!(
+            report.errors.iter().any(
+                |e| (e.line, e.col) == (line, col) && msg.iter().all(|m| e.message.contains(m))
+            ),
+            "no error at {line}:{col} saying {msg:?}; got {all:#?}\n{text}"
+        );
+    }
 }
 
 fn lapidary_check(files: &[String]) -> (Option<i32>, String, String) {

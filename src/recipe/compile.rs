@@ -356,15 +356,21 @@ impl Compiler<'_> {
         let mut pops = vec![];
         let mut mats: Vec<(String, StackDesc)> = vec![];
         let mut ok = true;
+        // Errors point into the population they are about: its entry, or its `density` value.
+        let list = r.source.find_from(from, &["platelets", ":"]);
         for (k, p) in desc.platelets.iter().enumerate() {
-            let at = r.source.find_from(from, &["platelets", ":"]);
+            let at = list.and_then(|l| r.source.nth_element(l, k)).or(list);
+            let entry_list = at.and_then(|a| r.source.find_from(a, &["entries", ":"]));
             let mut entries = vec![];
             let total: f32 = p.entries.iter().map(|e| e.0).sum();
             let mut acc = 0.0;
-            for e in &p.entries {
+            for (j, e) in p.entries.iter().enumerate() {
                 let name = &e.1;
                 let quoted = format!("{name:?}");
-                let pos = at.and_then(|a| r.source.find_from(a, &[&quoted])).or(at);
+                let pos = entry_list
+                    .and_then(|l| r.source.nth_element(l, j))
+                    .and_then(|entry| r.source.find_from(entry, &[&quoted]))
+                    .or(at);
                 let stack = match r.library.stack(name) {
                     Ok(mut s) => {
                         s.outside_ior = desc.ior;
@@ -416,8 +422,15 @@ impl Compiler<'_> {
             match Population::new(p.density, p.radius, orientation, entries, seed) {
                 Some(pop) => pops.push(pop),
                 None => {
+                    let density = at
+                        .and_then(|a| r.source.find_from(a, &["density", ":"]))
+                        .and_then(|key| {
+                            let colon = key + r.source.text[key..].find(':')?;
+                            Some(r.source.skip_blank(colon + 1))
+                        })
+                        .or(at);
                     self.errors.push(r.source.error(
-                        at,
+                        density,
                         format!(
                             "body.platelets[{k}]: density {} with radius up to {} puts more than \
                              {} platelets in each cell of 2.2 × the largest radius on average: \

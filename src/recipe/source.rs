@@ -219,7 +219,7 @@ impl Source {
     }
 
     /// The first byte at or after `pos` that is neither blank nor inside a comment.
-    fn skip_blank(&self, mut pos: usize) -> usize {
+    pub(crate) fn skip_blank(&self, mut pos: usize) -> usize {
         while let Some(c) = self.text[pos..].chars().next() {
             if c.is_whitespace() || self.in_comment(pos) {
                 pos += c.len_utf8();

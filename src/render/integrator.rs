@@ -29,6 +29,14 @@
 //! offset (`keep_off_the_boundary`), or its next ray could miss the boundary and leave the stone.
 //! Scenes without a body never run this code (the `transmission` and `medium` effects).
 //!
+//! **Platelets** (issue 18). Inside the body the nearest of the boundary and a platelet is the
+//! surface, and the free flight runs up to it; platelets are walked only up to the boundary (a
+//! ray that meets none is outside the stone by rounding). A ray leaving a platelet skips it (`path.platelet`)
+//! instead of being offset from the disc, and starts at least the spawn offset inside the boundary
+//! ahead (`keep_off_the_boundary`): a disc the boundary cuts is hit arbitrarily close to it, and an
+//! offset along the disc's normal put the next ray outside the stone, where it met no boundary and
+//! bounced among the population's discs beyond the stone until `max_depth` (tests/platelets.rs).
+//!
 //! **Variants.** [`trace`] is generic over the transported light `S` and monomorphised per variant
 //! ([`crate::spectrum`]); the film receives the path's radiance as a stored colour.
 //!
@@ -97,11 +105,16 @@ where
         sampler.skip_to(slots::bounce(path.depth));
         out.rays += 1;
         let mut found = world.intersect(&ray, f32::INFINITY);
-        if !world.platelets.is_empty() && path.medium == world.interior {
-            let t_max = found.as_ref().map_or(f32::INFINITY, Hit::t);
-            if let Some(h) = world.platelet_hit(&ray, t_max, path.platelet) {
-                found = Some(h);
-            }
+        // The boundary ahead when a platelet hides it (platelets are walked only up to the
+        // boundary: a ray inside the body that meets no boundary is outside the stone by rounding,
+        // where the population's discs are not part of it).
+        let mut hidden: Option<Hit> = None;
+        if !world.platelets.is_empty()
+            && path.medium == world.interior
+            && let Some(t_max) = found.as_ref().map(Hit::t)
+            && let Some(h) = world.platelet_hit(&ray, t_max, path.platelet)
+        {
+            hidden = found.replace(h);
         }
         if let Some(flakes) = &world.flakes
             && path.medium == world.interior
@@ -137,7 +150,8 @@ where
                         break;
                     }
                     let Some(phase) = medium.phase() else { break };
-                    let p = keep_off_the_boundary(ray.at(t), &ray, found.as_ref());
+                    let ahead = hidden.as_ref().or(found.as_ref());
+                    let p = keep_off_the_boundary(ray.at(t), &ray, ahead);
                     let Some(ps) = phase.sample(-ray.dir, sampler.get2d()) else {
                         break;
                     };
@@ -237,7 +251,15 @@ where
         if !path.alive() {
             break;
         }
-        ray = Ray::in_medium(offset_origin(sb.p, sb.ng, bs.wi), bs.wi, path.medium);
+        let origin = match hit {
+            // The platelet is skipped by the next ray, so it needs no offset from the disc; the
+            // hit is kept off the boundary ahead like a scattering point (a hit on a disc the
+            // boundary cuts can lie within rounding of it; the move, at most the spawn offset,
+            // may put the origin behind the disc it leaves, which the ray then passes).
+            Hit::Platelet { p, .. } => keep_off_the_boundary(p, &ray, hidden.as_ref()),
+            _ => offset_origin(sb.p, sb.ng, bs.wi),
+        };
+        ray = Ray::in_medium(origin, bs.wi, path.medium);
     }
     out.radiance = path.l.to_rgb(&path.lambda);
     out
