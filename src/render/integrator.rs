@@ -118,11 +118,11 @@ where
         }
         if let Some(flakes) = &world.flakes
             && path.medium == world.interior
+            && let Some(t_max) = found.as_ref().map(Hit::t)
         {
-            let t_max = found.as_ref().map_or(f32::INFINITY, Hit::t);
             let u = sampler.get2d_at(slots::platelet(path.depth));
             if let Some(c) = flakes.collide(ray.dir, t_max, u) {
-                found = Some(Hit::Platelet {
+                hidden = found.replace(Hit::Platelet {
                     t: c.t,
                     p: ray.at(c.t),
                     n: c.normal,
