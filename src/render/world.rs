@@ -333,7 +333,11 @@ impl World {
         let (stone_lo, stone_hi) = stone.bounds();
         let size = (stone_hi - stone_lo).max_element().max(1e-6);
         let ground = stage.ground.map(|g| {
-            let resting = shows_body && (stone_lo.y - g.height).abs() <= 1e-3 * size;
+            // Only where the map shows the body (forcing `transmission` on for a stone that
+            // stays opaque must not move its floor).
+            let resting = shows_body
+                && scene.effects.called(Effect::Transmission)
+                && (stone_lo.y - g.height).abs() <= 1e-3 * size;
             (
                 if resting {
                     g.height.min(stone_lo.y) - 1e-4 * size
