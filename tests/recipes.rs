@@ -236,6 +236,7 @@ fn info_names_the_body_and_the_recipe_line_that_turned_transmission_and_medium_o
         "sunstone-pink",
         "sunstone-patterned",
         "aventurine-glass",
+        "oregon-sunstone",
         "tinted-glass-sphere",
         "milky-stone",
     ] {
