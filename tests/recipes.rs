@@ -26,7 +26,7 @@ fn compile(text: &str) -> Scene {
 #[test]
 fn compiling_twice_gives_identical_tables() {
     let gems = shipped();
-    assert_eq!(gems.len(), 9, "{gems:?}");
+    assert_eq!(gems.len(), 10, "{gems:?}");
     let mut hashes = vec![];
     for path in gems {
         let a = GemRecipe::load(&path).unwrap().compile().unwrap();
@@ -36,7 +36,7 @@ fn compiling_twice_gives_identical_tables() {
     }
     hashes.sort_unstable();
     hashes.dedup();
-    assert_eq!(hashes.len(), 9, "every recipe hashes differently");
+    assert_eq!(hashes.len(), 10, "every recipe hashes differently");
 }
 
 #[test]
@@ -236,6 +236,7 @@ fn info_names_the_body_and_the_recipe_line_that_turned_transmission_and_medium_o
         "sunstone-pink",
         "sunstone-patterned",
         "aventurine-glass",
+        "oregon-sunstone",
         "tinted-glass-sphere",
         "milky-stone",
     ] {
@@ -248,7 +249,15 @@ fn info_names_the_body_and_the_recipe_line_that_turned_transmission_and_medium_o
             .unwrap_or_else(|| panic!("{file} has no body"));
         let text = info(&[&file]);
         let transmission = format!("on   transmission             body ({file}:{line})");
-        let medium = format!("on   medium                   body ({file}:{line}) medium");
+        // The medium effect names the line of `body.medium`'s key.
+        let medium_line = line
+            + 1
+            + source
+                .lines()
+                .skip(line)
+                .position(|l| l.trim_start().starts_with("medium:"))
+                .unwrap_or_else(|| panic!("{file} has no body.medium"));
+        let medium = format!("on   medium                   body.medium ({file}:{medium_line})");
         for expected in [
             transmission.as_str(),
             medium.as_str(),
