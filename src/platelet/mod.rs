@@ -157,13 +157,7 @@ impl Population {
             let center =
                 origin + Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * self.cell;
             let normal = self.orientation.sample(rng.uniform(), rng.uniform());
-            let u = rng.uniform();
-            let material = self
-                .entries
-                .iter()
-                .find(|(w, _)| u < *w)
-                .or(self.entries.last())
-                .map_or(0, |e| e.1);
+            let material = pick_entry(&self.entries, rng.uniform());
             let p = Platelet {
                 center,
                 normal,
@@ -195,6 +189,16 @@ impl Orientation {
                 .normalize(),
         }
     }
+}
+
+/// The material of the entry `u ∈ [0, 1)` falls in, from cumulative weights (last = 1).
+#[inline]
+pub fn pick_entry(entries: &[(f32, u32)], u: f32) -> u32 {
+    entries
+        .iter()
+        .find(|(w, _)| u < *w)
+        .or(entries.last())
+        .map_or(0, |e| e.1)
 }
 
 /// A Poisson-distributed count with mean `lambda` by inversion of the CDF at `u`, capped at

@@ -149,13 +149,7 @@ impl FlakeMedium {
         }
         let n = normal?;
         let n = if n.dot(d) < 0.0 { n } else { -n };
-        let v = rng.uniform();
-        let material = flakes
-            .entries
-            .iter()
-            .find(|(w, _)| v < *w)
-            .or(flakes.entries.last())
-            .map_or(0, |e| e.1);
+        let material = super::pick_entry(&flakes.entries, rng.uniform());
         Some(FlakeCollision {
             t,
             normal: n,

@@ -39,18 +39,6 @@ fn radius_range<'de, D: Deserializer<'de>>(d: D) -> Result<(f32, f32), D::Error>
     }
 }
 
-fn axis<'de, D: Deserializer<'de>>(d: D) -> Result<(f32, f32, f32), D::Error> {
-    let v = <(f32, f32, f32)>::deserialize(d)?;
-    let len = (v.0 * v.0 + v.1 * v.1 + v.2 * v.2).sqrt();
-    if len.is_finite() && len > 1e-6 {
-        Ok(v)
-    } else {
-        Err(serde::de::Error::custom(format!(
-            "axis = {v:?}: needs a finite, non-zero direction"
-        )))
-    }
-}
-
 fn entry_list<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<EntryDesc>, D::Error> {
     super::ranged::bounded_list(d, "platelets.entries", MAX_ENTRIES, true)
 }
@@ -78,7 +66,7 @@ pub enum OrientationDesc {
     /// 0 ..= 90) about `axis` (object space; Oregon sunstone's schiller).
     Aligned {
         /// The common normal.
-        #[serde(deserialize_with = "axis")]
+        #[serde(deserialize_with = "super::surface::axis_check")]
         axis: (f32, f32, f32),
         /// Half-angle of the cone, degrees.
         #[serde(default, deserialize_with = "spread_range")]

@@ -42,7 +42,7 @@ fn octaves_range<'de, D: Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
     }
 }
 
-fn axis_check<'de, D: Deserializer<'de>>(d: D) -> Result<(f32, f32, f32), D::Error> {
+pub(super) fn axis_check<'de, D: Deserializer<'de>>(d: D) -> Result<(f32, f32, f32), D::Error> {
     let v = <(f32, f32, f32)>::deserialize(d)?;
     let len = (v.0 * v.0 + v.1 * v.1 + v.2 * v.2).sqrt();
     if len.is_finite() && len > 1e-6 {
