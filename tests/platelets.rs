@@ -57,6 +57,8 @@ mod demand;
 mod energy;
 #[path = "platelets/hard.rs"]
 mod hard;
+#[path = "platelets/manifold.rs"]
+mod manifold;
 #[path = "platelets/order.rs"]
 mod order;
 #[path = "platelets/stats.rs"]

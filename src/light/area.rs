@@ -243,13 +243,19 @@ impl Area {
         }
     }
 
-    /// Uniform area sampling converted to solid angle.
-    fn sample_area(&self, p: Vec3, u: Vec2) -> Option<LightSample> {
+    /// A point uniformly distributed over the light's area (density `1 / area` per world unit²),
+    /// from `u ∈ [0, 1)²`; manifold next-event estimation samples lights this way.
+    pub fn sample_point(&self, u: Vec2) -> Vec3 {
         let local = match self.outline {
             Outline::Rect { hx, hy } => Vec2::new((2.0 * u.x - 1.0) * hx, (2.0 * u.y - 1.0) * hy),
             Outline::Disc { radius } => concentric_disc(u) * radius,
         };
-        let q = self.center + self.frame.s * local.x + self.frame.t * local.y;
+        self.center + self.frame.s * local.x + self.frame.t * local.y
+    }
+
+    /// Uniform area sampling converted to solid angle.
+    fn sample_area(&self, p: Vec3, u: Vec2) -> Option<LightSample> {
+        let q = self.sample_point(u);
         let d = q - p;
         let dist = d.length();
         let wi = d / dist;

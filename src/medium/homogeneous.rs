@@ -52,6 +52,14 @@ impl Homogeneous {
         }))
     }
 
+    /// See [`super::Medium::transmittance`].
+    #[inline]
+    pub fn transmittance<S: Spectral>(&self, t: f32, lambda: &S::Wavelengths) -> S {
+        let sigma_t =
+            S::from_unbounded(self.sigma_a, lambda) + S::from_unbounded(self.sigma_s, lambda);
+        transmittance(sigma_t, t)
+    }
+
     /// See [`super::Medium::free_flight`].
     #[inline]
     pub fn free_flight<S: Spectral>(

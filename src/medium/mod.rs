@@ -88,6 +88,16 @@ impl Medium {
         }
     }
 
+    /// The transmittance `e^(−σt t)` per channel over `t` world units (a shadow segment; 1 in a
+    /// vacuum).
+    #[inline]
+    pub fn transmittance<S: Spectral>(&self, t: f32, lambda: &S::Wavelengths) -> S {
+        match self {
+            Medium::Vacuum => S::ONE,
+            Medium::Homogeneous(h) => h.transmittance(t, lambda),
+        }
+    }
+
     /// The phase function at a scattering point (`None` in a vacuum, which never scatters).
     #[inline]
     pub fn phase(&self) -> Option<HenyeyGreenstein> {

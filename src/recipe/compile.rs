@@ -189,6 +189,9 @@ impl Compiler<'_> {
             names.push(name);
         }
         let stage = super::resolve::stage(r, &mut self.effects, &mut self.errors);
+        if let (Some(b), Some(st)) = (&body, &stage) {
+            self.manifold_effect(b, st);
+        }
         let accuracy = self.accuracy();
         let hash = recipe_hash(r);
         let ok = self.errors.is_empty() && stacks.len() == names.len();
@@ -341,6 +344,41 @@ impl Compiler<'_> {
             ));
         }
         Some(body)
+    }
+
+    /// Turns on manifold next-event estimation (issue 18) where it can help: a body the surface
+    /// shows, with a smooth boundary (the walk solves Snell's law at a specular interface), holding
+    /// platelets or a scattering medium (vertices inside that scatter light), under at least one
+    /// emitting area light (the walk connects to points on lights).
+    fn manifold_effect(&mut self, body: &Body, stage: &crate::scene::stage::Stage) {
+        let r = self.recipe;
+        let scatters_inside = !body.platelets.is_empty()
+            || body
+                .medium
+                .is_some_and(|m| m.sigma_s.max_channel() > 0.0);
+        let lit = stage
+            .lights
+            .iter()
+            .any(|l| l.radiance.max_channel() > 0.0);
+        if self.effects.called(Effect::Transmission) && body.alpha == 0.0 && scatters_inside && lit
+        {
+            let at = r.source.find(&["body", ":"]);
+            let e = r.source.error(at, "");
+            self.effects.turn_on(
+                Effect::ManifoldNee,
+                format!(
+                    "body ({}:{}): a smooth boundary around {}, under {} area light(s)",
+                    e.file,
+                    e.line,
+                    if body.platelets.is_empty() {
+                        "a scattering medium"
+                    } else {
+                        "platelets"
+                    },
+                    stage.lights.len()
+                ),
+            );
+        }
     }
 
     /// The body's platelet populations and the materials of their faces (each under the body's

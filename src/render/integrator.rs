@@ -42,7 +42,8 @@
 //!
 //! **Sample dimensions.** The slot layout is [`crate::sampler`]'s (written once there).
 
-use super::path::{PathSample, PathState};
+use super::manifold;
+use super::path::{ManifoldVertex, PathSample, PathState};
 use super::shading::{SurfaceBsdf, shade};
 use super::world::{Hit, LightRef, World};
 use crate::bsdf::{Bsdf, Bxdf, power_heuristic};
@@ -155,6 +156,36 @@ where
                     let Some(ps) = phase.sample(-ray.dir, sampler.get2d()) else {
                         break;
                     };
+                    path.manifold = None;
+                    if let Some(setup) = &world.manifold
+                        && strategy != Strategy::BsdfOnly
+                    {
+                        let (u_light, u_point, u_map) =
+                            (sampler.get1d(), sampler.get2d(), sampler.get1d());
+                        if let Some(ml) = manifold::sample_light::<S>(
+                            world,
+                            setup,
+                            p,
+                            None,
+                            u_light,
+                            u_point,
+                            u_map,
+                            &path.lambda,
+                        ) {
+                            let f = phase.value(-ray.dir, ml.d);
+                            let w = manifold_weight(strategy, ml.pdf, f * ml.cross, true);
+                            let c = path.throughput() * ml.value * (f * w);
+                            if c.is_valid() {
+                                path.l += c;
+                            }
+                        }
+                        path.manifold = Some(ManifoldVertex {
+                            p,
+                            d: ps.wi,
+                            pdf: ps.pdf,
+                            crossed: false,
+                        });
+                    }
                     path.scatter_in_medium(ps.pdf, p);
                     path.platelet = None;
                     if path.depth >= RR_DEPTH {
@@ -180,13 +211,20 @@ where
             }
             Some(Hit::Light { index, t }) => {
                 let le = S::from_unbounded(world.areas[index].emitted(-ray.dir), &path.lambda);
-                let w = emission_weight(world, strategy, &path, || {
-                    let origin = path.prev.map_or(ray.origin, |v| v.p);
-                    (
-                        LightRef::Area(index),
-                        world.areas[index].pdf(origin, ray.dir, t),
-                    )
-                });
+                let w = match (path.manifold, &world.manifold) {
+                    // One refraction out of the stone since a vertex where the walk ran.
+                    (Some(v), Some(setup)) if v.crossed => {
+                        let p_walk = manifold::density(world, setup, v.p, v.d, ray.at(t), index);
+                        manifold_weight(strategy, p_walk, v.pdf, false)
+                    }
+                    _ => emission_weight(world, strategy, &path, || {
+                        let origin = path.prev.map_or(ray.origin, |v| v.p);
+                        (
+                            LightRef::Area(index),
+                            world.areas[index].pdf(origin, ray.dir, t),
+                        )
+                    }),
+                };
                 path.add_emission(le, w);
                 if path.depth == 0 {
                     out.depth = Some(t);
@@ -222,6 +260,36 @@ where
                 world, strategy, &sb, wo_local, u_light, u_point, &mut path, &mut out,
             );
         }
+        // Manifold next-event estimation from a platelet: the light it sees through the boundary.
+        let walk = match (&world.manifold, &hit) {
+            (Some(setup), Hit::Platelet { id, .. })
+                if strategy != Strategy::BsdfOnly && !sb.flags().is_specular_only() =>
+            {
+                let x0 = keep_off_the_boundary(sb.p, &ray, hidden.as_ref());
+                let skip = (id.population != u32::MAX).then_some(*id);
+                if let Some(ml) = manifold::sample_light::<S>(
+                    world,
+                    setup,
+                    x0,
+                    skip,
+                    u_light,
+                    u_point,
+                    u_switch,
+                    &path.lambda,
+                ) && sb.admits(ml.d)
+                {
+                    let (wi_local, f) = sb.eval::<S>(wo_local, ml.d);
+                    let p_bsdf = sb.pdf::<S>(wo_local, wi_local) * ml.cross;
+                    let w = manifold_weight(strategy, ml.pdf, p_bsdf, true);
+                    let c = path.throughput() * f * ml.value * (wi_local.z.abs() * w);
+                    if c.is_valid() {
+                        path.l += c;
+                    }
+                }
+                Some(x0)
+            }
+            _ => None,
+        };
 
         // Continue the path by sampling the BSDF.
         let uc = sampler.get1d();
@@ -233,6 +301,30 @@ where
             // `transmission=off`: the boundary only reflects.
             break;
         }
+        path.manifold = match (walk, path.manifold) {
+            // A delta lobe at the vertex is not a direction the walk can produce.
+            (Some(_), _) if bs.flags.is_specular() => None,
+            (Some(x0), _) => Some(ManifoldVertex {
+                p: x0,
+                d: bs.wi,
+                pdf: bs.pdf,
+                crossed: false,
+            }),
+            (None, Some(v))
+                if !v.crossed
+                    && matches!(hit, Hit::Stone(_))
+                    && bs.flags.is_specular()
+                    && bs.flags.is_transmission()
+                    && !sb.faceted =>
+            {
+                Some(ManifoldVertex {
+                    pdf: v.pdf * bs.pdf,
+                    crossed: true,
+                    ..v
+                })
+            }
+            _ => None,
+        };
         path.scatter(&bs, sb.p, sb.inside);
         path.platelet = match hit {
             Hit::Platelet { id, .. } => Some(id),
@@ -339,6 +431,28 @@ fn direct_light<S: Spectral>(
     let c = path.throughput() * f * radiance * (wi_local.z.abs() * w / p_light);
     if c.is_valid() {
         path.l += c;
+    }
+}
+
+/// Weight of one of the two ways to a light through the boundary (module [`manifold`]):
+/// `p_walk` and `p_bsdf` are the densities of the direction at the vertex by the walk and by BSDF
+/// sampling; `walk` says which technique produced the contribution. Light sampling only keeps the
+/// walk's contributions (and BSDF sampling's where the walk cannot produce the path); BSDF
+/// sampling only never runs the walk.
+#[inline]
+fn manifold_weight(strategy: Strategy, p_walk: f32, p_bsdf: f32, walk: bool) -> f32 {
+    match (strategy, walk) {
+        (Strategy::Mis, true) => power_heuristic(p_walk, p_bsdf),
+        (Strategy::Mis, false) => power_heuristic(p_bsdf, p_walk),
+        (Strategy::LightOnly, true) => 1.0,
+        (Strategy::LightOnly, false) => {
+            if p_walk > 0.0 {
+                0.0
+            } else {
+                1.0
+            }
+        }
+        (Strategy::BsdfOnly, _) => 1.0,
     }
 }
 

@@ -14,6 +14,7 @@ pub mod camera;
 pub mod film;
 pub mod filter;
 pub mod integrator;
+pub mod manifold;
 pub mod memory;
 pub mod output;
 pub mod path;

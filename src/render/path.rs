@@ -40,6 +40,22 @@ pub struct PrevVertex {
     pub nee: bool,
 }
 
+/// A vertex inside the stone where manifold next-event estimation ran, and the BSDF-sampled
+/// continuation from it: if the path then refracts out through the boundary and meets a light,
+/// that light is weighted against the walk's ([`super::manifold`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ManifoldVertex {
+    /// The vertex: the origin of the ray that left it.
+    pub p: Vec3,
+    /// The sampled direction (unit, world space).
+    pub d: Vec3,
+    /// Density of the continuation: the direction's per steradian, times the boundary's
+    /// probability of refracting once crossed.
+    pub pdf: f32,
+    /// Whether the path has since refracted out through the boundary, and done nothing else.
+    pub crossed: bool,
+}
+
 /// Everything a path knows between two vertices, generic over the transported light `S`.
 #[derive(Clone, Copy, Debug)]
 pub struct PathState<S: Spectral> {
@@ -69,6 +85,9 @@ pub struct PathState<S: Spectral> {
     pub medium_events: u32,
     /// The event that produced the current ray; `None` for the camera ray.
     pub prev: Option<PrevVertex>,
+    /// The last vertex where manifold next-event estimation ran, while the path since is its
+    /// BSDF-sampled continuation toward the boundary.
+    pub manifold: Option<ManifoldVertex>,
 }
 
 impl<S: Spectral> PathState<S> {
@@ -86,6 +105,7 @@ impl<S: Spectral> PathState<S> {
             depth: 0,
             medium_events: 0,
             prev: None,
+            manifold: None,
         }
     }
 

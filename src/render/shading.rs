@@ -45,6 +45,8 @@ pub struct SurfaceBsdf<'a> {
     pub frame: Frame,
     /// The medium behind the surface (what a transmission from outside enters).
     pub inside: MediumId,
+    /// Whether the frame is a facet's (a tilted crystal facet of the map), not the surface's.
+    pub faceted: bool,
     bxdf: &'a Bsdf,
     flags: LobeFlags,
 }
@@ -192,7 +194,7 @@ impl World {
     /// The BSDF at a hit described by `ctx`, for the incoming direction `wo` (world, toward the
     /// viewer); `None` when the material is unused or there is no floor.
     pub fn bsdf_at<W>(&self, ctx: &ShadingContext<W>, wo: Vec3) -> Option<SurfaceBsdf<'_>> {
-        let (bxdf, frame, inside) = match ctx.material {
+        let (bxdf, frame, inside, faceted) = match ctx.material {
             Some(m) => {
                 let bxdf = self.materials.get(m as usize)?.as_ref()?;
                 // A reflecting model is symmetric: its frame faces the viewer. An interface that
@@ -205,15 +207,15 @@ impl World {
                     -ctx.ns
                 };
                 let base = Frame::from_normal(n);
-                let frame = match ctx.facet {
-                    Some(facet) if self.facet_bump => facet_frame(&base, facet, wo),
-                    _ => base,
+                let (frame, faceted) = match ctx.facet {
+                    Some(facet) if self.facet_bump => (facet_frame(&base, facet, wo), true),
+                    _ => (base, false),
                 };
-                (bxdf, frame, self.interior)
+                (bxdf, frame, self.interior, faceted)
             }
             None => {
                 let (_, bxdf) = self.ground.as_ref()?;
-                (bxdf, Frame::from_normal(ctx.ns), MediumId::OUTSIDE)
+                (bxdf, Frame::from_normal(ctx.ns), MediumId::OUTSIDE, false)
             }
         };
         Some(SurfaceBsdf {
@@ -222,6 +224,7 @@ impl World {
             ns: ctx.ns,
             frame,
             inside,
+            faceted,
             bxdf,
             flags: bxdf.flags(),
         })

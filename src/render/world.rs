@@ -166,6 +166,8 @@ pub struct World {
     /// The platelets' statistical form (`platelets: statistical`): a medium of flakes instead of
     /// [`World::platelets`].
     pub flakes: Option<crate::platelet::statistical::FlakeMedium>,
+    /// Manifold next-event estimation through the smooth boundary (the `manifold-nee` effect).
+    pub manifold: Option<super::manifold::ManifoldSetup>,
     /// Whether the free-flight code runs on every segment (the `medium` effect): a body with an
     /// absorbing or scattering interior, or the effect forced on.
     pub medium: bool,
@@ -385,6 +387,12 @@ impl World {
             })
             .collect();
 
+        let manifold = match body {
+            Some(b) if shows_body && b.alpha == 0.0 && scene.effects.on(Effect::ManifoldNee) => {
+                super::manifold::ManifoldSetup::new(b.ior, scene.surface.body_index(), &areas)
+            }
+            _ => None,
+        };
         Ok(World {
             stone,
             ground,
@@ -422,6 +430,7 @@ impl World {
                 }
                 _ => None,
             },
+            manifold,
             medium: medium_on,
             map: scene.surface.map.with_effects(MapEffects {
                 overlay: scene.effects.forced(Effect::GlitterOverlay) != Some(false),

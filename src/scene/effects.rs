@@ -32,11 +32,14 @@ pub enum Effect {
     Medium,
     /// Metal platelets suspended in a body (volumetric aventurescence).
     Platelets,
+    /// Manifold next-event estimation: light sampled through a smooth boundary from platelets and
+    /// medium points inside the stone (Hanika et al. 2015).
+    ManifoldNee,
 }
 
 impl Effect {
     /// Every effect, in a fixed order.
-    pub const ALL: [Effect; 12] = [
+    pub const ALL: [Effect; 13] = [
         Effect::Absorption,
         Effect::TTerm,
         Effect::FacetBump,
@@ -45,6 +48,7 @@ impl Effect {
         Effect::Transmission,
         Effect::Medium,
         Effect::Platelets,
+        Effect::ManifoldNee,
         Effect::Spectral,
         Effect::Fluorescence,
         Effect::DepthOfField,
@@ -62,6 +66,7 @@ impl Effect {
             Effect::Transmission => "transmission",
             Effect::Medium => "medium",
             Effect::Platelets => "platelets",
+            Effect::ManifoldNee => "manifold-nee",
             Effect::Spectral => "spectral",
             Effect::Fluorescence => "fluorescence",
             Effect::DepthOfField => "depth-of-field",
@@ -90,6 +95,9 @@ impl Effect {
             Effect::Transmission => "a recipe `body` that the surface map shows (`Body`)",
             Effect::Medium => "a `body` whose `medium` absorbs or scatters",
             Effect::Platelets => "a `body` with `platelets`",
+            Effect::ManifoldNee => {
+                "a smooth `body` boundary around platelets or a scattering medium, under an area light"
+            }
             Effect::Spectral => "spectral colours",
             Effect::Fluorescence => "a fluorescent material",
             Effect::DepthOfField => "a perspective camera with aperture > 0",
