@@ -98,6 +98,18 @@ impl Medium {
         }
     }
 
+    /// The smallest extinction `σt` over the RGB channels, per world unit (0 in a vacuum).
+    #[inline]
+    pub fn min_extinction(&self) -> f32 {
+        match self {
+            Medium::Vacuum => 0.0,
+            Medium::Homogeneous(h) => {
+                let t = h.sigma_a + h.sigma_s;
+                t.0[0].min(t.0[1]).min(t.0[2])
+            }
+        }
+    }
+
     /// The phase function at a scattering point (`None` in a vacuum, which never scatters).
     #[inline]
     pub fn phase(&self) -> Option<HenyeyGreenstein> {

@@ -160,8 +160,8 @@ where
                     if let Some(setup) = &world.manifold
                         && strategy != Strategy::BsdfOnly
                     {
-                        let (u_light, u_point, u_map) =
-                            (sampler.get1d(), sampler.get2d(), sampler.get1d());
+                        let (u_light, u_point, u_more) =
+                            (sampler.get1d(), sampler.get2d(), sampler.get2d());
                         if let Some(ml) = manifold::sample_light::<S>(
                             world,
                             setup,
@@ -169,7 +169,8 @@ where
                             None,
                             u_light,
                             u_point,
-                            u_map,
+                            u_more.x,
+                            u_more.y,
                             &path.lambda,
                         ) {
                             let f = phase.value(-ray.dir, ml.d);
@@ -267,6 +268,7 @@ where
             {
                 let x0 = keep_off_the_boundary(sb.p, &ray, hidden.as_ref());
                 let skip = (id.population != u32::MAX).then_some(*id);
+                let u_walk = sampler.get1d();
                 if let Some(ml) = manifold::sample_light::<S>(
                     world,
                     setup,
@@ -275,6 +277,7 @@ where
                     u_light,
                     u_point,
                     u_switch,
+                    u_walk,
                     &path.lambda,
                 ) && sb.admits(ml.d)
                 {

@@ -276,45 +276,99 @@ pub const STAGES: u32 = 4;
 /// Convergence of an intermediate stage.
 const STAGE_TOLERANCE: f32 = 1e-3;
 
-/// Newton's method on the direction at `x0` from `seed` (module docs), the step halved while the
-/// constraint grows: the converged direction, or `None`.
+/// Newton's method on the direction at `x0` from `seed` (module docs) with Broyden's rank-one
+/// updates of the Jacobian (Broyden, "A class of methods for solving nonlinear simultaneous
+/// equations", Math. Comp. 19, 1965): the finite-difference Jacobian is taken once at the seed
+/// (two ray casts) and then updated from each step's change of the constraint, so an iteration
+/// costs one cast; where a step fails to lower the constraint even when halved, the Jacobian is
+/// taken afresh by differences, once per failure. The coordinates stay those of the seed: `d` in
+/// the tangent frame of `seed`, the constraint in the tangent basis of the seed's boundary point.
+/// Returns the converged direction, or `None`.
 fn newton(world: &World, x0: Vec3, x2: Vec3, eta: f32, seed: Vec3, tolerance: f32) -> Option<Vec3> {
+    let frame = Frame::from_normal(seed);
+    let (mut c, h) = constraint(world, x0, seed, x2, eta)?;
+    let b = Frame::from_normal(h.ns);
+    let basis = (b.s, b.t);
+    let coords = |c: Vec3| Vec2::new(c.dot(basis.0), c.dot(basis.1));
+    let mut a = Vec2::ZERO;
     let mut d = seed;
-    let (mut c, mut h) = constraint(world, x0, d, x2, eta)?;
+    let mut j = constraint_jacobian(world, x0, d, x2, eta, basis, c, false)?;
+    let mut fresh = true;
     for _ in 0..MAX_ITERATIONS {
         if c.length() < tolerance {
             return Some(d);
         }
-        let b = Frame::from_normal(h.ns);
-        let basis = (b.s, b.t);
-        let j = constraint_jacobian(world, x0, d, x2, eta, basis, c, false)?;
         let dt = det(&j);
-        if !(dt.abs() > 1e-12) || !dt.is_finite() {
-            return None;
-        }
-        let r = Vec2::new(c.dot(basis.0), c.dot(basis.1));
-        let mut step = -Vec2::new(j[1][1] * r.x - j[0][1] * r.y, j[0][0] * r.y - j[1][0] * r.x) / dt;
+        let r = coords(c);
+        let mut step = if dt.abs() > 1e-12 && dt.is_finite() {
+            -Vec2::new(j[1][1] * r.x - j[0][1] * r.y, j[0][0] * r.y - j[1][0] * r.x) / dt
+        } else {
+            Vec2::ZERO
+        };
         if step.length() > MAX_STEP {
             step *= MAX_STEP / step.length();
         }
-        let f = Frame::from_normal(d);
-        let mut moved = false;
-        for _ in 0..=MAX_HALVINGS {
-            let trial = turn(&f, step);
-            if let Some((ct, ht)) = constraint(world, x0, trial, x2, eta)
-                && ct.length() < c.length()
-            {
-                (d, c, h) = (trial, ct, ht);
-                moved = true;
-                break;
+        let mut accepted = None;
+        if step.length() > 0.0 {
+            for _ in 0..=MAX_HALVINGS {
+                let trial = turn(&frame, a + step);
+                if let Some((ct, _)) = constraint(world, x0, trial, x2, eta)
+                    && ct.length() < c.length()
+                {
+                    accepted = Some((trial, ct));
+                    break;
+                }
+                step *= 0.5;
             }
-            step *= 0.5;
         }
-        if !moved {
-            return None;
+        match accepted {
+            Some((trial, ct)) => {
+                // Broyden: J += (Δr − J Δa) Δaᵀ / |Δa|².
+                let dr = coords(ct) - r;
+                let jda = Vec2::new(
+                    j[0][0] * step.x + j[0][1] * step.y,
+                    j[1][0] * step.x + j[1][1] * step.y,
+                );
+                let k = (dr - jda) / step.length_squared();
+                j[0][0] += k.x * step.x;
+                j[0][1] += k.x * step.y;
+                j[1][0] += k.y * step.x;
+                j[1][1] += k.y * step.y;
+                (a, d, c) = (a + step, trial, ct);
+                fresh = false;
+            }
+            // A step from a fresh Jacobian that cannot lower the constraint: give up.
+            None if fresh => return None,
+            None => {
+                j = finite_difference_at(world, x0, &frame, a, x2, eta, basis, c)?;
+                fresh = true;
+            }
         }
     }
     (c.length() < tolerance).then_some(d)
+}
+
+/// The forward-difference Jacobian of the constraint in the seed's coordinates at `a` (the
+/// constraint there is `c`).
+#[allow(clippy::too_many_arguments)]
+fn finite_difference_at(
+    world: &World,
+    x0: Vec3,
+    frame: &Frame,
+    a: Vec2,
+    x2: Vec3,
+    eta: f32,
+    basis: (Vec3, Vec3),
+    c: Vec3,
+) -> Option<[[f32; 2]; 2]> {
+    let mut j = [[0.0; 2]; 2];
+    for (col, dir) in [Vec2::X, Vec2::Y].into_iter().enumerate() {
+        let plus = constraint(world, x0, turn(frame, a + dir * FD_STEP), x2, eta)?.0;
+        let diff = (plus - c) / FD_STEP;
+        j[0][col] = diff.dot(basis.0);
+        j[1][col] = diff.dot(basis.1);
+    }
+    Some(j)
 }
 
 /// `|dω0/dA2|` (world units⁻²) of the refracted path from `x0` along `d` to the light point `x2`
@@ -384,11 +438,16 @@ pub fn sample_light<S: Spectral>(
     u_light: f32,
     u_point: Vec2,
     u_map: f32,
+    u_walk: f32,
     lambda: &S::Wavelengths,
 ) -> Option<ManifoldLight<S>> {
     let (index, p_pick) = setup.pick(u_light)?;
     let light = &world.areas[index];
     let x2 = light.sample_point(u_point);
+    let q = walk_probability(world, x0, x2);
+    if !(u_walk < q) {
+        return None;
+    }
     let c = solve(world, x0, x2, light.normal(), setup.eta)?;
     let x1 = c.exit.p;
     let u = (x2 - x1) / c.dist;
@@ -422,7 +481,7 @@ pub fn sample_light<S: Spectral>(
         tr = tr * (-flakes.sigma(c.d) * c.exit.t).exp();
     }
     let cross = transmittance(c.exit.cos_inside, setup.eta);
-    let pdf = p_pick / (light.area() * c.jacobian);
+    let pdf = q * p_pick / (light.area() * c.jacobian);
     let value = tr * S::from_unbounded(le, lambda) * (cross * setup.eta * setup.eta / pdf);
     (pdf.is_finite() && pdf > 0.0 && value.is_valid()).then_some(ManifoldLight {
         d: c.d,
@@ -450,11 +509,41 @@ pub fn density(
     }
     match jacobian(world, x0, d, x2, light.normal(), setup.eta) {
         Some(j) => {
-            let p = p_pick / (light.area() * j);
+            let p = walk_probability(world, x0, x2) * p_pick / (light.area() * j);
             if p.is_finite() { p } else { 0.0 }
         }
         None => 0.0,
     }
+}
+
+/// Transmittance below which the walk is run only sometimes ([`walk_probability`]).
+pub const WALK_THRESHOLD: f32 = 0.05;
+
+/// The probability with which the walk runs from `x0` toward the light point `x2`: 1 unless the
+/// interior in front of it is thick — `min(1, T/`[`WALK_THRESHOLD`]`)`, with `T` the largest
+/// per-channel transmittance (medium and statistical platelets) over the straight line to the
+/// boundary. A walk costs tens of ray casts and deep in a dense medium brings next to nothing
+/// (the milky stone scatters every 0.05 units); running it with probability `q` and dividing by
+/// `q` keeps the estimate unbiased, and `q` enters its density for the MIS weight.
+pub fn walk_probability(world: &World, x0: Vec3, x2: Vec3) -> f32 {
+    if !world.medium && world.flakes.is_none() {
+        return 1.0;
+    }
+    let Some(d) = (x2 - x0).try_normalize() else {
+        return 1.0;
+    };
+    let Some((h, _)) = boundary(world, x0, d) else {
+        return 1.0;
+    };
+    let mut tau = if world.medium {
+        world.media[usize::from(world.interior.0)].min_extinction() * h.t
+    } else {
+        0.0
+    };
+    if let Some(flakes) = &world.flakes {
+        tau += flakes.sigma(d) * h.t;
+    }
+    ((-tau).exp() / WALK_THRESHOLD).clamp(1e-6, 1.0)
 }
 
 /// Fresnel transmittance `1 − F` of the boundary for a direction inside meeting it at
