@@ -104,7 +104,7 @@ mod tests {
         let n = 100_000;
         let mut sum = 0.0f64;
         for i in 0..n {
-            let u = thinning_uniform(5, [i as i32 % 7 - 3, i as i32 / 7, -4], i as u32 % 3);
+            let u = thinning_uniform(5, [i % 7 - 3, i / 7, -4], i as u32 % 3);
             assert!((0.0..1.0).contains(&u));
             sum += f64::from(u);
         }

@@ -331,7 +331,10 @@ mod tests {
             for id in [a, b, sum, prod, remap] {
                 let (lo, hi) = t.bounds(id);
                 let v = t.eval(id, p);
-                assert!(lo <= v && v <= hi, "field {id} at {p}: {v} not in {lo} ..= {hi}");
+                assert!(
+                    lo <= v && v <= hi,
+                    "field {id} at {p}: {v} not in {lo} ..= {hi}"
+                );
             }
         }
         let big = t.add(FieldNode::Constant(3e38)).unwrap();
