@@ -55,7 +55,7 @@
 //! the tests are repeatable.
 //!
 //! Runtime (release, two idle cores): ≈ 10 s for the file (`cargo test --release --test
-//! platelets`). The heavier furnace (256 spp, ≈ 70 s): `cargo test --release --test platelets --
+//! platelets`), plus ≈ 6 s for claim 7's modules (measured on two loaded cores). The heavier furnace (256 spp, ≈ 70 s): `cargo test --release --test platelets --
 //! --ignored --nocapture`.
 
 mod common;
