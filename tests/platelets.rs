@@ -1,5 +1,5 @@
 //! Metal platelets in depth (issue 18): the point process, the walk, and the light they return,
-//! end to end. Six claims, five in the modules here:
+//! end to end. Seven claims, six in the modules here:
 //!
 //! 1. [`stats`] — the population matches its recipe: platelets per cell are Poisson with mean
 //!    `density · cell³` (per-cell chi-square, total against `density × volume`, neighbouring
@@ -22,8 +22,17 @@
 //! 5. [`demand`] — a gem without platelets renders bit-identically with the `platelets` effect
 //!    forced on or off; a gem with platelets changes when they are forced off, and then equals the
 //!    same gem without them.
-//! 6. Recipe errors: rows `platelets_*` and `platelet_errors_point_into_their_population` in
-//!    tests/recipe_errors.rs.
+//! 6. Recipe errors: rows `platelets_*` (`platelets_modulation_*` for the density modulation) and
+//!    `platelet_errors_point_into_their_population` in tests/recipe_errors.rs.
+//! 7. Modulated density (`body.platelets[k].modulation`, `sunstone-patterned`): [`thinning`] — the
+//!    platelets per region follow `density × ∫ m` (chi-square over 30 slabs of a sine modulation
+//!    and over 216 blocks of the patterned sunstone's three-Perlin field), each platelet is kept iff
+//!    its own `(seed, cell, index)` uniform is below `m(centre)`, indices stay, any order gives the
+//!    same set; [`flights`] — the statistical form's free flights follow `σ_k m_k(t) e^{−Λ(t)}`
+//!    (chi-square against the closed form along two rays, 200 000 flights each), the
+//!    null-collision bound acts as documented, the world reads the field in object space;
+//!    [`unmodulated`] — without a modulation the platelets and flights are those recorded before it
+//!    existed (hashes), and a modulation of 1 changes no bit of a render.
 //!
 //! **Finding (fixed): paths lost at the boundary.** A ray leaving a platelet was offset from the
 //! disc along its normal; on a disc the boundary cuts, a hit within that offset (2e-5) of the
@@ -46,7 +55,7 @@
 //! the tests are repeatable.
 //!
 //! Runtime (release, two idle cores): ≈ 10 s for the file (`cargo test --release --test
-//! platelets`). The heavier furnace (256 spp, ≈ 70 s): `cargo test --release --test platelets --
+//! platelets`), plus ≈ 6 s for claim 7's modules (measured on two loaded cores). The heavier furnace (256 spp, ≈ 70 s): `cargo test --release --test platelets --
 //! --ignored --nocapture`.
 
 mod common;
@@ -55,6 +64,8 @@ mod common;
 mod demand;
 #[path = "platelets/energy.rs"]
 mod energy;
+#[path = "platelets/flights.rs"]
+mod flights;
 #[path = "platelets/hard.rs"]
 mod hard;
 #[path = "platelets/manifold.rs"]
@@ -63,6 +74,10 @@ mod manifold;
 mod order;
 #[path = "platelets/stats.rs"]
 mod stats;
+#[path = "platelets/thinning.rs"]
+mod thinning;
+#[path = "platelets/unmodulated.rs"]
+mod unmodulated;
 
 use glam::Vec3;
 use lapidary::geometry::Ray;

@@ -1,4 +1,8 @@
 //! Walking a ray through the platelet grid (3-D DDA, Amanatides & Woo 1987) and hitting discs.
+//!
+//! The walk sees exactly the platelets [`Population::each_in_cell`] gives (thinned when the
+//! population's density is modulated); the cells, and so the walk's steps, are those of the
+//! unmodulated population.
 
 use super::{PlateletHit, PlateletId, Population};
 use glam::Vec3;
@@ -99,7 +103,9 @@ fn walk(
             for dy in range[1][0]..=range[1][1] {
                 for dz in range[2][0]..=range[2][1] {
                     let ci = [c.x as i32 + dx, c.y as i32 + dy, c.z as i32 + dz];
-                    pop.each_in_cell(ci, |k, p| {
+                    // Every drawn disc is tested; only a hit asks whether the disc survived
+                    // thinning (the modulation's field is evaluated for hits alone).
+                    pop.each_drawn(ci, |k, p| {
                         let id = PlateletId {
                             population: index,
                             cell: ci,
@@ -114,6 +120,7 @@ fn walk(
                         if let Some(t) =
                             hit_disc(p.center, p.normal, p.radius, o, d, lo_t, hi_t * 1.000_001)
                             && t <= hi_t.max(lo_t)
+                            && pop.kept(ci, k, &p)
                         {
                             found = Some(PlateletHit {
                                 t,
@@ -159,6 +166,44 @@ mod tests {
     fn walk_matches_brute_force() {
         let pop =
             Population::new(400.0, (0.02, 0.06), Orientation::Uniform, vec![(1.0, 0)], 3).unwrap();
+        check_walk(&pop, 200);
+    }
+
+    /// So does the walk of a thinned population (a modulation that is 0 for `x < −0.3`, 1 for
+    /// `x > 0.3` and a ramp between): it meets only the discs that survived.
+    #[test]
+    fn walk_of_a_modulated_population_matches_brute_force() {
+        use crate::texture::{FieldNode, FieldTable, Octaves};
+        let mut t = FieldTable::default();
+        let x = t
+            .add(FieldNode::Marble {
+                inv_scale: 0.05,
+                axis: Vec3::X,
+                turbulence: 0.0,
+                octaves: Octaves {
+                    octaves: 1,
+                    gain: 0.5,
+                    lacunarity: 2.0,
+                    seed: 1,
+                },
+            })
+            .unwrap();
+        // ½ + ½ sin(2π·0.05 x) ≈ ½ + 0.157 x near 0: remapped to 0 … 1 over x ∈ [−0.3, 0.3].
+        let ramp = t
+            .add(FieldNode::Remap {
+                input: x,
+                from: [0.453, 0.547],
+                to: [0.0, 1.0],
+                clamp: true,
+            })
+            .unwrap();
+        let pop = Population::new(400.0, (0.02, 0.06), Orientation::Uniform, vec![(1.0, 0)], 3)
+            .unwrap()
+            .with_modulation(crate::platelet::Modulation::new(t, ramp));
+        check_walk(&pop, 80);
+    }
+
+    fn check_walk(pop: &Population, min_hits: usize) {
         let mut rng = Rng::new(11);
         let mut scratch: Vec<Platelet> = vec![];
         let mut hits = 0;
@@ -166,7 +211,7 @@ mod tests {
             let o = Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * 2.0 - 1.0;
             let d = Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * 2.0 - 1.0;
             let t_max = 0.6;
-            let walked = intersect(std::slice::from_ref(&pop), o, d, 0.0, t_max, None);
+            let walked = intersect(std::slice::from_ref(pop), o, d, 0.0, t_max, None);
             // Brute force over the cells of the segment's bounding box.
             let (a, b) = (o, o + d * t_max);
             // Discs reach one cell beyond their own.
@@ -191,6 +236,6 @@ mod tests {
             assert_eq!(walked.map(|h| h.t), best, "o {o} d {d}");
             hits += usize::from(best.is_some());
         }
-        assert!(hits > 200, "the test needs hits: {hits}");
+        assert!(hits > min_hits, "the test needs hits: {hits}");
     }
 }

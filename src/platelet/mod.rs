@@ -18,9 +18,15 @@
 //! platelets parallel to one crystal plane). A platelet's face is a layered material evaluated
 //! relative to the host (the stack's `outside_ior` is the body's IOR: metal under glass reflects
 //! with `(n + ik)/n_host`).
+//!
+//! Density: uniform, or modulated by a field over object space ([`modulation`]): the platelets are
+//! generated at the full density and thinned, each kept with probability `m(centre)`.
 
 pub mod grid;
+pub mod modulation;
 pub mod statistical;
+
+pub use modulation::Modulation;
 
 use crate::sampler::{Rng, hash_words};
 use glam::Vec3;
@@ -61,8 +67,11 @@ pub struct Population {
     pub seed: u64,
     /// Cell edge (object units).
     pub cell: f32,
-    /// Mean platelets per cell, `density · cell³`.
+    /// Mean platelets per cell before thinning, `density · cell³`.
     pub mean_per_cell: f32,
+    /// The density's modulation, a factor in `[0, 1]` at each point; `None`: uniform density
+    /// (the generation is then exactly that of an unmodulated population).
+    pub modulation: Option<Modulation>,
 }
 
 /// One platelet: a disc.
@@ -126,11 +135,19 @@ impl Population {
                 seed,
                 cell,
                 mean_per_cell,
+                modulation: None,
             },
         )
     }
 
-    /// The platelets of cell `c`, in a fixed order (a pure function of the seed and the cell).
+    /// The same population with its density multiplied by `modulation` (clamped to `[0, 1]`) at
+    /// each platelet's centre; the grid and every platelet's attributes stay those of `self`.
+    pub fn with_modulation(self, modulation: Option<Modulation>) -> Population {
+        Population { modulation, ..self }
+    }
+
+    /// The platelets of cell `c` that survive thinning, in a fixed order (a pure function of the
+    /// seed and the cell).
     pub fn cell_platelets(&self, c: [i32; 3], out: &mut Vec<Platelet>) {
         out.clear();
         self.each_in_cell(c, |_, p| {
@@ -139,10 +156,32 @@ impl Population {
         });
     }
 
-    /// Calls `f(index, platelet)` for the platelets of cell `c` in order, generating them one by
-    /// one (no allocation); stops early when `f` returns true.
+    /// Calls `f(index, platelet)` for the platelets of cell `c` that survive thinning
+    /// ([`Population::kept`]), in order, generating them one by one (no allocation); stops early
+    /// when `f` returns true. A dropped platelet's index is not reused.
     #[inline]
     pub fn each_in_cell(&self, c: [i32; 3], mut f: impl FnMut(u32, Platelet) -> bool) {
+        self.each_drawn(c, |index, p| self.kept(c, index, &p) && f(index, p));
+    }
+
+    /// Whether platelet `index` of cell `c` (as [`Population::each_drawn`] gives it) survives
+    /// thinning: always without a modulation, else iff its own uniform number
+    /// ([`modulation::thinning_uniform`]) is below the modulation at its centre.
+    #[inline]
+    pub fn kept(&self, c: [i32; 3], index: u32, p: &Platelet) -> bool {
+        match &self.modulation {
+            None => true,
+            Some(m) => modulation::survives(m.at(p.center), || {
+                modulation::thinning_uniform(self.seed, c, index)
+            }),
+        }
+    }
+
+    /// Calls `f(index, platelet)` for every platelet drawn in cell `c` before thinning, in order
+    /// (the walk tests a disc first and asks [`Population::kept`] only of the discs it hits);
+    /// stops early when `f` returns true.
+    #[inline]
+    pub fn each_drawn(&self, c: [i32; 3], mut f: impl FnMut(u32, Platelet) -> bool) {
         let key = hash_words(&[
             self.seed,
             c[0] as u32 as u64,

@@ -163,7 +163,7 @@ mod tests {
             ("lepidolite.ron", 20, 3),
             ("sunstone.ron", 5, 1),
             ("sunstone-pink.ron", 4, 1),
-            ("sunstone-patterned.ron", 3, 1),
+            ("sunstone-patterned.ron", 4, 1),
             ("green-aventurine.ron", 12, 2),
             ("raspberry-aventurine.ron", 12, 2),
             ("aventurine-glass.ron", 6, 1),

@@ -308,7 +308,9 @@ impl<'a> Compiler<'a> {
         }
     }
 
-    fn field(&mut self, desc: &FieldDesc) -> FieldId {
+    /// Compiles a field description into [`Compiler::fields`] (children first); default seeds
+    /// continue the running count.
+    pub(super) fn field(&mut self, desc: &FieldDesc) -> FieldId {
         let octaves = |this: &mut Self, n: u32, gain: f32, lacunarity: f32, seed: Option<u64>| {
             let s = this.seed(seed);
             Octaves {

@@ -15,6 +15,7 @@ pub mod gem;
 pub mod library;
 mod map_compiler;
 pub mod material;
+mod platelet_compiler;
 pub mod platelets;
 mod resolve;
 pub mod source;

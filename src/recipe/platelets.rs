@@ -10,13 +10,22 @@
 //!         orientation: Uniform,           // or Aligned(axis: (0.0, 1.0, 0.0), spread: 5.0)
 //!         entries: [(1.0, "copper_flake"), (0.5, "copper_rough")],  // weights and materials
 //!         seed: 3,                        // optional (default: from the recipe seed)
+//!         modulation: Remap(field: Perlin(scale: 0.5), from: (-0.5, 0.5), to: (0.0, 1.0)),
+//!                                         // optional: density × field, clamped to 0 ..= 1
 //!     )],
 //! )
 //! ```
 //!
 //! A platelet's faces are the named layered materials, evaluated under the body's IOR (their
 //! outside medium is the stone: metal in glass reflects with the relative index `(n + ik)/n_host`).
+//!
+//! `modulation` is a field of the kind a map's `Switch` compares (`Perlin`, `Turbulence`,
+//! `Marble`, `Constant`, `Sum`, `Product`, `Remap`; see [`super::surface::FieldDesc`]) over
+//! object space; its value, clamped to `0 ..= 1`, multiplies `density` at each point
+//! ([`crate::platelet::modulation`]). Its numbers are range-checked as a Switch's are; a field that
+//! cannot exceed 0 anywhere (an empty population) is an error.
 
+use super::surface::FieldDesc;
 use serde::{Deserialize, Deserializer, Serialize};
 
 /// Most populations a body may hold.
@@ -93,4 +102,8 @@ pub struct PlateletsDesc {
     /// position).
     #[serde(default, deserialize_with = "super::stage::seed_range")]
     pub seed: Option<u64>,
+    /// Density modulation: a field over object space whose value, clamped to `0 ..= 1`
+    /// (dimensionless), multiplies `density` at each point (default: none, uniform density).
+    #[serde(default)]
+    pub modulation: Option<FieldDesc>,
 }

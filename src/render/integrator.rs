@@ -122,7 +122,7 @@ where
             && let Some(t_max) = found.as_ref().map(Hit::t)
         {
             let u = sampler.get2d_at(slots::platelet(path.depth));
-            if let Some(c) = flakes.collide(ray.dir, t_max, u) {
+            if let Some(c) = flakes.collide(ray.origin, ray.dir, t_max, u) {
                 hidden = found.replace(Hit::Platelet {
                     t: c.t,
                     p: ray.at(c.t),

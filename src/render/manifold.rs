@@ -478,7 +478,7 @@ pub fn sample_light<S: Spectral>(
         S::ONE
     };
     if let Some(flakes) = &world.flakes {
-        tr = tr * (-flakes.sigma(c.d) * c.exit.t).exp();
+        tr = tr * (-flakes.optical_depth(x0, c.d, c.exit.t)).exp();
     }
     let cross = transmittance(c.exit.cos_inside, setup.eta);
     let pdf = q * p_pick / (light.area() * c.jacobian);
@@ -541,6 +541,7 @@ pub fn walk_probability(world: &World, x0: Vec3, x2: Vec3) -> f32 {
         0.0
     };
     if let Some(flakes) = &world.flakes {
+        // The majorant (cheap); `q` is a heuristic: any `q > 0` keeps the estimate unbiased.
         tau += flakes.sigma(d) * h.t;
     }
     ((-tau).exp() / WALK_THRESHOLD).clamp(1e-6, 1.0)

@@ -136,6 +136,66 @@ impl FieldTable {
         if v.is_finite() { v } else { 0.0 }
     }
 
+    /// A conservative interval `(lo, hi)` holding every value [`FieldTable::eval`] can return for
+    /// field `id` (field units): Perlin noise is bounded by 2 (each corner term `|u| + |v|` of
+    /// offsets within a cell, so fBm lies in `[−2, 2]` and turbulence in `[0, 2]`, though both
+    /// stay near `[−1, 1]` in practice), marble in `[0, 1]`, composites by interval arithmetic. An
+    /// interval that overflows is `(−∞, ∞)`; an unknown `id` too.
+    pub fn bounds(&self, id: FieldId) -> (f32, f32) {
+        const ALL: (f32, f32) = (f32::NEG_INFINITY, f32::INFINITY);
+        let Some(node) = self.nodes.get(id as usize) else {
+            return ALL;
+        };
+        let args = |first: u32, count: u32| {
+            self.args
+                .get(first as usize..(first + count) as usize)
+                .unwrap_or(&[])
+                .iter()
+                .map(|&f| self.bounds(f))
+        };
+        let (lo, hi) = match *node {
+            FieldNode::Constant(c) => (c, c),
+            FieldNode::Fbm { .. } => (-2.0, 2.0),
+            FieldNode::Turbulence { .. } => (0.0, 2.0),
+            FieldNode::Marble { .. } => (0.0, 1.0),
+            FieldNode::Sum { first, count } => {
+                args(first, count).fold((0.0, 0.0), |(a, b), (c, d)| (a + c, b + d))
+            }
+            FieldNode::Product { first, count } => {
+                args(first, count).fold((1.0f32, 1.0f32), |(a, b), (c, d)| {
+                    if !(a.is_finite() && b.is_finite() && c.is_finite() && d.is_finite()) {
+                        return ALL;
+                    }
+                    let p = [a * c, a * d, b * c, b * d];
+                    (
+                        p.into_iter().fold(f32::INFINITY, f32::min),
+                        p.into_iter().fold(f32::NEG_INFINITY, f32::max),
+                    )
+                })
+            }
+            FieldNode::Remap {
+                input,
+                from,
+                to,
+                clamp,
+            } => {
+                let (a, b) = self.bounds(input);
+                let map = |v: f32| {
+                    let t = (v - from[0]) / (from[1] - from[0]);
+                    let t = if clamp { t.clamp(0.0, 1.0) } else { t };
+                    to[0] + t * (to[1] - to[0])
+                };
+                let (x, y) = (map(a), map(b));
+                (x.min(y), x.max(y))
+            }
+        };
+        if lo.is_finite() && hi.is_finite() && lo <= hi {
+            (lo, hi)
+        } else {
+            ALL
+        }
+    }
+
     fn eval_raw(&self, id: FieldId, p: Vec3) -> f32 {
         match self.nodes[id as usize] {
             FieldNode::Constant(c) => c,
@@ -231,6 +291,56 @@ mod tests {
             })
             .is_err()
         );
+    }
+
+    /// Every value lies in the interval [`FieldTable::bounds`] gives.
+    #[test]
+    fn bounds_hold_every_value() {
+        let mut t = FieldTable::default();
+        let a = t
+            .add(FieldNode::Fbm {
+                inv_scale: 5.0,
+                octaves: octaves(3),
+            })
+            .unwrap();
+        let b = t
+            .add(FieldNode::Turbulence {
+                inv_scale: 2.0,
+                octaves: octaves(4),
+            })
+            .unwrap();
+        let c = t.add(FieldNode::Constant(-0.5)).unwrap();
+        let (first, count) = t.add_args(&[a, b, c]);
+        let sum = t.add(FieldNode::Sum { first, count }).unwrap();
+        let prod = t.add(FieldNode::Product { first, count }).unwrap();
+        let remap = t
+            .add(FieldNode::Remap {
+                input: sum,
+                from: [1.0, -1.0],
+                to: [0.0, 3.0],
+                clamp: false,
+            })
+            .unwrap();
+        assert_eq!(t.bounds(sum), (-2.5, 3.5));
+        assert_eq!(t.bounds(remap), (-3.75, 5.25));
+        assert_eq!(t.bounds(c), (-0.5, -0.5));
+        assert_eq!(t.bounds(99), (f32::NEG_INFINITY, f32::INFINITY));
+        let mut rng = Rng::new(5);
+        for _ in 0..20_000 {
+            let p = Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * 8.0 - 4.0;
+            for id in [a, b, sum, prod, remap] {
+                let (lo, hi) = t.bounds(id);
+                let v = t.eval(id, p);
+                assert!(
+                    lo <= v && v <= hi,
+                    "field {id} at {p}: {v} not in {lo} ..= {hi}"
+                );
+            }
+        }
+        let big = t.add(FieldNode::Constant(3e38)).unwrap();
+        let (first, count) = t.add_args(&[big, big]);
+        let over = t.add(FieldNode::Product { first, count }).unwrap();
+        assert_eq!(t.bounds(over), (f32::NEG_INFINITY, f32::INFINITY));
     }
 
     #[test]
