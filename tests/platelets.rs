@@ -1,5 +1,5 @@
 //! Metal platelets in depth (issue 18): the point process, the walk, and the light they return,
-//! end to end. Seven claims, six in the modules here:
+//! end to end. Eight claims, seven in the modules here:
 //!
 //! 1. [`stats`] — the population matches its recipe: platelets per cell are Poisson with mean
 //!    `density · cell³` (per-cell chi-square, total against `density × volume`, neighbouring
@@ -33,6 +33,14 @@
 //!    null-collision bound acts as documented, the world reads the field in object space;
 //!    [`unmodulated`] — without a modulation the platelets and flights are those recorded before it
 //!    existed (hashes), and a modulation of 1 changes no bit of a render.
+//! 8. Manifold next-event estimation through the smooth boundary ([`manifold`]): without an
+//!    interface the walk's measure is the inverse-square law; through a glass sphere its integral
+//!    over a light equals the solid angle of the refracted rays that reach it (4 M shot directions,
+//!    five vertices, some near the boundary) and the walk finds the shot directions; manifold NEE
+//!    with MIS, manifold NEE alone and BSDF sampling alone converge to the same image for platelets
+//!    and for a scattering medium (paired z-tests, 131 072 paths), and the walk lowers the standard
+//!    error (0.45× and 0.32× at equal paths); the effect is called only for a smooth boundary
+//!    around scatterers under an area light.
 //!
 //! **Finding (fixed): paths lost at the boundary.** A ray leaving a platelet was offset from the
 //! disc along its normal; on a disc the boundary cuts, a hit within that offset (2e-5) of the

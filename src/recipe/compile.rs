@@ -350,13 +350,8 @@ impl Compiler<'_> {
     fn manifold_effect(&mut self, body: &Body, stage: &crate::scene::stage::Stage) {
         let r = self.recipe;
         let scatters_inside = !body.platelets.is_empty()
-            || body
-                .medium
-                .is_some_and(|m| m.sigma_s.max_channel() > 0.0);
-        let lit = stage
-            .lights
-            .iter()
-            .any(|l| l.radiance.max_channel() > 0.0);
+            || body.medium.is_some_and(|m| m.sigma_s.max_channel() > 0.0);
+        let lit = stage.lights.iter().any(|l| l.radiance.max_channel() > 0.0);
         if self.effects.called(Effect::Transmission) && body.alpha == 0.0 && scatters_inside && lit
         {
             let at = r.source.find(&["body", ":"]);

@@ -48,9 +48,9 @@
 use super::world::World;
 use crate::bsdf::{fresnel, refract};
 use crate::geometry::{Frame, Ray, StoneHit, offset_origin};
+use crate::light::Area;
 use crate::platelet::PlateletId;
 use crate::spectrum::Spectral;
-use crate::light::Area;
 use glam::{Vec2, Vec3};
 
 /// Most Newton iterations of one walk.
@@ -249,7 +249,11 @@ pub fn solve(world: &World, x0: Vec3, x2: Vec3, n_light: Vec3, eta: f32) -> Opti
             let mut d = seed;
             for k in 1..=STAGES {
                 let eta_k = 1.0 + (eta - 1.0) * k as f32 / STAGES as f32;
-                let tol = if k == STAGES { TOLERANCE } else { STAGE_TOLERANCE };
+                let tol = if k == STAGES {
+                    TOLERANCE
+                } else {
+                    STAGE_TOLERANCE
+                };
                 d = newton(world, x0, x2, eta_k, d, tol)?;
             }
             d
@@ -478,7 +482,7 @@ pub fn sample_light<S: Spectral>(
         S::ONE
     };
     if let Some(flakes) = &world.flakes {
-        tr = tr * (-flakes.optical_depth(x0, c.d, c.exit.t)).exp();
+        tr *= (-flakes.optical_depth(x0, c.d, c.exit.t)).exp();
     }
     let cross = transmittance(c.exit.cos_inside, setup.eta);
     let pdf = q * p_pick / (light.area() * c.jacobian);

@@ -8,8 +8,8 @@
 //! converge to the same image, for platelets and for a scattering medium, and the walk lowers the
 //! variance.
 
-use super::{Acc, build, gem, z_limit};
 use super::energy::trace_image;
+use super::{Acc, build, gem, z_limit};
 use glam::{Vec2, Vec3};
 use lapidary::render::manifold::{self, exit, solve};
 use lapidary::render::{Strategy, World};
@@ -68,7 +68,11 @@ fn walk_without_interface_is_the_inverse_square_law() {
         assert!(conn.d.dot(straight) > 1.0 - 1e-6, "{x0} → {x2}: {}", conn.d);
         let expect = straight.dot(n).abs() / (x2 - x0).length_squared();
         let rel = conn.jacobian / expect - 1.0;
-        assert!(rel.abs() < 2e-3, "{x0} → {x2}: {} vs {expect}", conn.jacobian);
+        assert!(
+            rel.abs() < 2e-3,
+            "{x0} → {x2}: {} vs {expect}",
+            conn.jacobian
+        );
     }
 }
 
@@ -236,10 +240,19 @@ fn converge(label: &str, body: &str, light_radius: f32, spp: u32) {
             continue;
         }
         tested += 1;
-        check(&format!("block {k}: MIS − BSDF"), paired(&walk[k], &bsdf[k]));
-        check(&format!("block {k}: walk − BSDF"), paired(&alone[k], &bsdf[k]));
+        check(
+            &format!("block {k}: MIS − BSDF"),
+            paired(&walk[k], &bsdf[k]),
+        );
+        check(
+            &format!("block {k}: walk − BSDF"),
+            paired(&alone[k], &bsdf[k]),
+        );
     }
-    assert!(tested >= nb / 2, "{label}: only {tested} of {nb} blocks tested");
+    assert!(
+        tested >= nb / 2,
+        "{label}: only {tested} of {nb} blocks tested"
+    );
     let (tw, tb) = (total(&w_all), total(&b_all));
     let ratio = tw.se(0) / tb.se(0);
     println!(
@@ -249,7 +262,10 @@ fn converge(label: &str, body: &str, light_radius: f32, spp: u32) {
         tw.n
     );
     assert!(tw.mean(0) > 0.0, "{label}: the stone is lit");
-    assert!(ratio < 0.8, "{label}: the walk does not lower the variance ({ratio:.3})");
+    assert!(
+        ratio < 0.8,
+        "{label}: the walk does not lower the variance ({ratio:.3})"
+    );
 }
 
 /// Platelets (white Lambertian discs) in a clear sphere of glass: 16×16 pixels × 512 paths.
@@ -290,12 +306,16 @@ fn walk_is_called_only_for_a_smooth_boundary_with_scatterers_and_lights() {
     };
     let lit = lit_stage(0.5, 8, 1);
     assert!(called(&format!("(ior: 1.5, {platelets})"), &lit));
-    assert!(!called(&format!("(ior: 1.5, roughness: 2.0, {platelets})"), &lit));
-    assert!(!called("(ior: 1.5, medium: (absorption: (0.5, 0.5, 0.5)))", &lit));
+    assert!(!called(
+        &format!("(ior: 1.5, roughness: 2.0, {platelets})"),
+        &lit
+    ));
+    assert!(!called(
+        "(ior: 1.5, medium: (absorption: (0.5, 0.5, 0.5)))",
+        &lit
+    ));
     let dark = lit.replace("lights: [Disc(center: (0.0, 4.0, 0.0), target: (0.0, 0.0, 0.0), radius: 0.5,\n                        radiance: Gray(20.0))]", "lights: []");
     assert_ne!(dark, lit);
     assert!(!called(&format!("(ior: 1.5, {platelets})"), &dark));
     let _ = manifold::MAX_ITERATIONS;
 }
-
-
