@@ -26,7 +26,8 @@
 //!    tests/recipe_errors.rs.
 //! 7. [`walk`] — the grid walk returns, bit for bit (t, normal, material, id), the nearest hit
 //!    a brute force over the cells around the segment finds: random, long, axis-aligned and grazing
-//!    rays and rays leaving a disc, ≈ 39 000 queries over five populations and all five together.
+//!    rays and rays leaving a disc, ≈ 39 000 queries over five populations and all five together;
+//!    a stone whose diagonal spans more cells than a walk visits is an error, not a short walk.
 //!
 //! **Finding (fixed): paths lost at the boundary.** A ray leaving a platelet was offset from the
 //! disc along its normal; on a disc the boundary cuts, a hit within that offset (2e-5) of the

@@ -277,9 +277,11 @@ pub fn span(pop: &Population, lo: Vec3, hi: Vec3) -> u64 {
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 #[error(
     "body.platelets[{population}]: the stone spans {cells} platelet cells along its diagonal, at \
-     most {max} (allowed 1 ..= {max}); the cells are {cell} object units (the larger of 2.2 × the \
+     most {max} (allowed 1 ..= {max}); the cells are {} object units (the larger of 2.2 × the \
      largest radius and the volume holding 2 platelets on average): use a smaller stone (at most \
-     about {largest} object units along its diagonal), larger platelets or a lower density"
+     about {} object units along its diagonal), larger platelets or a lower density",
+    significant(*.cell),
+    significant(*.largest)
 )]
 pub struct SpanError {
     /// Index of the population.
@@ -293,6 +295,16 @@ pub struct SpanError {
     /// The longest diagonal the walk covers, object units (`MAX_SPAN` cells over three axes, a
     /// cube's diagonal).
     pub largest: f32,
+}
+
+/// `x` to four significant digits.
+fn significant(x: f32) -> String {
+    let digits = if x.is_normal() {
+        (3 - x.abs().log10().floor() as i32).clamp(0, 12) as usize
+    } else {
+        0
+    };
+    format!("{x:.digits$}")
 }
 
 /// Checks every population's [`span`] over the stone's object-space bounds `[lo, hi]`.

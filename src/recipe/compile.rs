@@ -189,6 +189,11 @@ impl Compiler<'_> {
             names.push(name);
         }
         let stage = super::resolve::stage(r, &mut self.effects, &mut self.errors);
+        if let (Some(b), Some(s)) = (&body, &stage)
+            && body_shown
+        {
+            self.check_platelet_span(b, s);
+        }
         let accuracy = self.accuracy();
         let hash = recipe_hash(r);
         let ok = self.errors.is_empty() && stacks.len() == names.len();

@@ -17,6 +17,7 @@ pub mod integrator;
 pub mod memory;
 pub mod output;
 pub mod path;
+pub mod setup;
 pub mod shading;
 pub mod study;
 pub mod world;

@@ -366,3 +366,45 @@ fn the_walk_is_the_brute_force_bit_for_bit() {
     }
     eprintln!("the old walk differed from the brute force on {old_differs} queries");
 }
+
+/// A stone too large for a population's walk (its diagonal spans more cells than a walk visits)
+/// is an error, never a walk that silently stops early: when the recipe is compiled for an
+/// analytic shape (tests/recipe_errors.rs, row `platelets_stone_too_large`), and when the world is
+/// built for a mesh (whose size the recipe does not know) or for platelets made explicit after
+/// compiling. Cells of 0.00585 (10⁷ per unit³): a 200-unit cube spans 102 598 of them, a sphere of
+/// radius 60 spans 61 558 (built), one of radius 200 spans 205 198.
+#[test]
+fn a_stone_too_large_for_the_walk_is_refused() {
+    use lapidary::render::{World, WorldError};
+    let pops = r#"(ior: 1.5, platelets: [(density: 10000000.0, radius: (0.001, 0.002),
+        orientation: Uniform, entries: [(1.0, "mirror")])])"#;
+    let refused = |e: Result<World, WorldError>, what: &str| match e {
+        Err(e @ WorldError::PlateletSpan(_)) => {
+            let msg = e.to_string();
+            assert!(
+                msg.contains("body.platelets[0]: the stone spans")
+                    && msg.contains("platelet cells along its diagonal, at most 65533"),
+                "{what}: {msg}"
+            );
+        }
+        Err(e) => panic!("{what}: another error: {e}"),
+        Ok(_) => panic!("{what}: the world was built"),
+    };
+    let cube = super::scene(&super::gem(
+        pops,
+        r#"(shape: Mesh(file: "tests/data/cube.obj", scale: 100.0))"#,
+    ));
+    refused(World::new(&cube), "a 200-unit cube mesh");
+    let mut big = super::scene(&super::gem(
+        pops,
+        "(shape: Sphere(radius: 200.0), render: (platelets: Statistical))",
+    ));
+    assert!(
+        World::new(&big).is_ok(),
+        "statistical platelets walk no cells"
+    );
+    big.stage.render.platelets_explicit = true;
+    refused(World::new(&big), "a sphere of radius 200, explicit");
+    let fits = super::scene(&super::gem(pops, "(shape: Sphere(radius: 60.0))"));
+    assert!(World::new(&fits).is_ok(), "a sphere of radius 60 fits");
+}
