@@ -1,5 +1,5 @@
 //! Metal platelets in depth (issue 18): the point process, the walk, and the light they return,
-//! end to end. Seven claims, six in the modules here:
+//! end to end. Eight claims, seven in the modules here:
 //!
 //! 1. [`stats`] — the population matches its recipe: platelets per cell are Poisson with mean
 //!    `density · cell³` (per-cell chi-square, total against `density × volume`, neighbouring
@@ -28,6 +28,10 @@
 //!    a brute force over the cells around the segment finds: random, long, axis-aligned and grazing
 //!    rays and rays leaving a disc, ≈ 39 000 queries over five populations and all five together;
 //!    a stone whose diagonal spans more cells than a walk visits is an error, not a short walk.
+//! 8. [`knobs`] — platelet faces call for effects (an absorbing coat turns `absorption` on,
+//!    credited to `body.platelets[k] entry j`, as `lapidary info` prints) and the accuracy knobs
+//!    rewrite them (`model=course`, `absorption=off`), from the recipe and through
+//!    `Scene::set_accuracy`.
 //!
 //! **Finding (fixed): paths lost at the boundary.** A ray leaving a platelet was offset from the
 //! disc along its normal; on a disc the boundary cuts, a hit within that offset (2e-5) of the
@@ -61,6 +65,8 @@ mod demand;
 mod energy;
 #[path = "platelets/hard.rs"]
 mod hard;
+#[path = "platelets/knobs.rs"]
+mod knobs;
 #[path = "platelets/order.rs"]
 mod order;
 #[path = "platelets/stats.rs"]
