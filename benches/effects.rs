@@ -11,7 +11,9 @@
 //! studio's pinhole camera for `depth-of-field`, a gradient sky as the only light for
 //! `environment-importance`, and the shipped opaque gem `gems/sunstone.ron` for `transmission` and
 //! `medium` (issue 17: forced on, the free-flight code runs on every segment through a medium that
-//! neither absorbs nor scatters). Each is 64 × 48 pixels, 16 spp, Sobol', max depth 8
+//! neither absorbs nor scatters), and the shipped clear body without platelets
+//! `gems/tinted-glass-sphere.ron` for `platelets` (issue 18: every path segment inside the body
+//! passes the platelet code's test, forced on or off). Each is 64 × 48 pixels, 16 spp, Sobol', max depth 8
 //! (`LAPIDARY_BENCH_SIZE=W` renders W × 3W/4), on one worker thread; the world is built outside
 //! the timed closure.
 //!
@@ -121,6 +123,7 @@ fn scenes() -> Vec<(Effect, Scene)> {
         (Effect::EnvironmentImportance, compile(sky)),
         (Effect::Transmission, gem("sunstone.ron")),
         (Effect::Medium, gem("sunstone.ron")),
+        (Effect::Platelets, gem("tinted-glass-sphere.ron")),
     ]
 }
 

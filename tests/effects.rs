@@ -16,7 +16,9 @@
 //! whose interior absorbs or scatters) are checked on the shipped opaque Sunstone (and, with every
 //! other effect, on the bare scene), each forced on and off alone and both together, on a recipe whose `body` the
 //! surface never shows, and — for `medium` — on clear bodies (no medium, a zero medium, a white
-//! colour), whose paths cross the boundary but need no free flight.
+//! colour), whose paths cross the boundary but need no free flight. Platelets (issue 18): a gem
+//! without them — the opaque Sunstone and the clear tinted glass sphere — renders bit-identically
+//! with the `platelets` code forced on or off (`benches/effects.rs` times it).
 //!
 //! Negative controls show the toggles are live: in a scene that calls for an effect, forcing it off
 //! changes the image (absorption, facet bump, glitter overlay, stochastic switch, depth of field,
@@ -606,6 +608,25 @@ fn transmission_and_medium_code_change_nothing_for_opaque_gems() {
                 ));
             }
         }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn platelet_code_changes_nothing_for_gems_without_platelets() {
+    // Issue 18's claim: a gem without platelets renders bit-identically with the `platelets`
+    // code forced on or off — an opaque gem and a clear, absorbing body whose paths run inside it.
+    let mut failures = vec![];
+    for name in ["sunstone.ron", "tinted-glass-sphere.ron"] {
+        let s = gem(name);
+        assert!(
+            s.surface
+                .body
+                .as_ref()
+                .is_none_or(|b| b.platelets.is_empty()),
+            "{name} has platelets"
+        );
+        failures.extend(untouched(Effect::Platelets, name, &s));
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }

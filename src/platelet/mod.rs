@@ -6,10 +6,11 @@
 //! cell — generated when a ray visits the cell and never stored for the whole stone ([`grid`]).
 //! Cells are at least `2.2 r_max` wide, so a disc reaches at most into the 26 neighbours of its
 //! cell. A ray walks the cells in order (a 3-D DDA, Amanatides & Woo, "A Fast Voxel Traversal
-//! Algorithm for Ray Tracing", Eurographics 1987); in each cell it tests the discs of that cell and
-//! of the neighbours its segment comes within `r_max` of, and keeps only hits inside the cell, so
-//! the first cell with a hit holds the nearest. Discs are two-sided and hit exactly (ray–plane,
-//! then the radius); the boundary clips them, since only the segment inside the body is walked.
+//! Algorithm for Ray Tracing", Eurographics 1987); at each cell it tests the discs of that cell and
+//! of the neighbours its segment comes within `r_max` of (each cell generated once per walk), and
+//! stops at the first cell whose exit lies beyond the nearest hit found. Discs are two-sided and
+//! hit exactly (ray–plane, then the radius); the boundary clips them, since only the segment
+//! inside the body is walked.
 //! (An earlier version kept each disc inside its own cell instead: that leaves slabs near the
 //! cell faces with fewer platelets, visible as stripes.)
 //!
@@ -88,8 +89,9 @@ pub struct Platelet {
 }
 
 /// Which platelet: its population, cell and index within the cell (to skip the platelet a ray
-/// leaves from).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+/// leaves from). Ordered by population, then cell, then index: of two hits at the same distance
+/// the walk keeps the smaller id.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct PlateletId {
     /// Population index.
     pub population: u32,
@@ -182,21 +184,11 @@ impl Population {
     /// stops early when `f` returns true.
     #[inline]
     pub fn each_drawn(&self, c: [i32; 3], mut f: impl FnMut(u32, Platelet) -> bool) {
-        let key = hash_words(&[
-            self.seed,
-            c[0] as u32 as u64,
-            c[1] as u32 as u64,
-            c[2] as u32 as u64,
-        ]);
-        let mut rng = Rng::new(key);
-        let n = poisson(self.mean_per_cell, rng.uniform());
-        let origin = Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32) * self.cell;
-        for index in 0..n {
-            let radius = self.radius.0 + (self.radius.1 - self.radius.0) * rng.uniform();
-            let center =
-                origin + Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * self.cell;
-            let normal = self.orientation.sample(rng.uniform(), rng.uniform());
-            let material = pick_entry(&self.entries, rng.uniform());
+        let mut stream = self.stream(c);
+        while let Some((index, center, radius)) = stream.next_disc() {
+            let Some((normal, material)) = stream.finish() else {
+                return;
+            };
             let p = Platelet {
                 center,
                 normal,
@@ -207,6 +199,84 @@ impl Population {
                 return;
             }
         }
+    }
+
+    /// The platelets of cell `c` drawn lazily: each disc's centre and radius first, its normal and
+    /// material only when asked for (the grid walk skips the normal of a disc whose bounding
+    /// sphere misses the ray). The same numbers as [`Population::each_in_cell`].
+    #[inline]
+    pub fn stream(&self, c: [i32; 3]) -> CellStream<'_> {
+        let key = hash_words(&[
+            self.seed,
+            c[0] as u32 as u64,
+            c[1] as u32 as u64,
+            c[2] as u32 as u64,
+        ]);
+        let mut rng = Rng::new(key);
+        let count = poisson(self.mean_per_cell, rng.uniform());
+        CellStream {
+            pop: self,
+            rng,
+            origin: Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32) * self.cell,
+            count,
+            next: 0,
+            pending: false,
+        }
+    }
+}
+
+/// Numbers a platelet draws after its radius and centre: two for the normal, one for the entry.
+const DRAWS_AFTER_CENTRE: u64 = 3;
+
+/// One cell's platelets, drawn in order from the cell's stream ([`Population::stream`]).
+#[derive(Clone, Debug)]
+pub struct CellStream<'a> {
+    pop: &'a Population,
+    rng: Rng,
+    /// The cell's lowest corner (object space).
+    origin: Vec3,
+    /// Platelets in the cell.
+    count: u32,
+    /// Index of the next platelet.
+    next: u32,
+    /// Whether the last platelet's normal and entry are still to be drawn.
+    pending: bool,
+}
+
+impl CellStream<'_> {
+    /// The next platelet's index, centre (object space) and radius (object units); `None` after
+    /// the last. Its normal and material follow from [`CellStream::finish`], or are skipped.
+    #[inline]
+    pub fn next_disc(&mut self) -> Option<(u32, Vec3, f32)> {
+        if std::mem::take(&mut self.pending) {
+            self.rng.skip(DRAWS_AFTER_CENTRE);
+        }
+        if self.next >= self.count {
+            return None;
+        }
+        let (r0, r1) = self.pop.radius;
+        let radius = r0 + (r1 - r0) * self.rng.uniform();
+        let (x, y, z) = (self.rng.uniform(), self.rng.uniform(), self.rng.uniform());
+        let center = self.origin + Vec3::new(x, y, z) * self.pop.cell;
+        let index = self.next;
+        self.next += 1;
+        self.pending = true;
+        Some((index, center, radius))
+    }
+
+    /// The unit normal and material index of the platelet [`CellStream::next_disc`] just gave;
+    /// `None` if there is none or they were already drawn.
+    #[inline]
+    pub fn finish(&mut self) -> Option<(Vec3, u32)> {
+        if !std::mem::take(&mut self.pending) {
+            return None;
+        }
+        let normal = self
+            .pop
+            .orientation
+            .sample(self.rng.uniform(), self.rng.uniform());
+        let material = pick_entry(&self.pop.entries, self.rng.uniform());
+        Some((normal, material))
     }
 }
 

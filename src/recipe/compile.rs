@@ -179,7 +179,7 @@ impl Compiler<'_> {
             // Errors in materials were reported when the library was read.
             if let Ok(stack) = r.library.stack(&name) {
                 if used[surface_index as usize] {
-                    self.stack_effects(&name, &stack);
+                    self.stack_effects(&format!("material \"{name}\""), &name, &stack);
                 }
                 stacks.push(stack);
             }
@@ -188,6 +188,11 @@ impl Compiler<'_> {
         let stage = super::resolve::stage(r, &mut self.effects, &mut self.errors);
         if let (Some(b), Some(st)) = (&body, &stage) {
             self.manifold_effect(b, st);
+        }
+        if let (Some(b), Some(s)) = (&body, &stage)
+            && body_shown
+        {
+            self.check_platelet_span(b, s);
         }
         let accuracy = self.accuracy();
         let hash = recipe_hash(r);
@@ -324,6 +329,10 @@ impl Compiler<'_> {
                     Effect::Platelets,
                     format!("body.platelets ({}:{})", e.file, e.line),
                 );
+                for (k, j, name, stack) in body.platelet_entries(body_index) {
+                    let element = format!("body.platelets[{k}] entry {j} material \"{name}\"");
+                    self.stack_effects(&element, name, stack);
+                }
             }
             if body.has_medium() {
                 let m = r.source.find_from(at.unwrap_or(0), &["medium", ":"]).or(at);
@@ -373,8 +382,9 @@ impl Compiler<'_> {
         }
     }
 
-    /// Effects a used material calls for.
-    fn stack_effects(&mut self, name: &str, stack: &StackDesc) {
+    /// Effects a used material `name` calls for, credited to `element` (`material "gold"`, or a
+    /// platelet entry).
+    fn stack_effects(&mut self, element: &str, name: &str, stack: &StackDesc) {
         let file = self
             .recipe
             .library
@@ -382,15 +392,13 @@ impl Compiler<'_> {
             .unwrap_or_else(|| "?".into());
         let (absorbing, t_term) = crate::scene::accuracy::stack_calls(stack);
         if let Some(i) = absorbing {
-            self.effects.turn_on(
-                Effect::Absorption,
-                format!("material \"{name}\" coats[{i}] ({file})"),
-            );
+            self.effects
+                .turn_on(Effect::Absorption, format!("{element} coats[{i}] ({file})"));
         }
         if t_term {
             self.effects.turn_on(
                 Effect::TTerm,
-                format!("material \"{name}\" ({file}, {:?} model)", stack.model),
+                format!("{element} ({file}, {:?} model)", stack.model),
             );
         }
     }

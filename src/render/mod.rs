@@ -18,6 +18,7 @@ pub mod manifold;
 pub mod memory;
 pub mod output;
 pub mod path;
+pub mod setup;
 pub mod shading;
 pub mod study;
 pub mod world;

@@ -1,10 +1,10 @@
 //! The runtime world the integrator traces: the placed stone, the floor, the lights and the
 //! material table, built once from a compiled [`Scene`].
 
-use crate::bsdf::{Bsdf, Bxdf, Lambert, LayeredBsdf, StackError};
+pub use super::setup::{PROGRESS_AFTER, Setup, WorldError};
+use crate::bsdf::{Bsdf, Bxdf, Lambert, LayeredBsdf};
 use crate::color::Rgb;
-use crate::geometry::{GeometryError, MediumId, Ray, Stone, StoneHit};
-use crate::image::ImageError;
+use crate::geometry::{MediumId, Ray, Stone, StoneHit};
 use crate::light::{Area, EnvironmentLight};
 use crate::medium::Medium;
 use crate::scene::{Effect, Scene};
@@ -14,69 +14,7 @@ use glam::{Vec2, Vec3};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::{Duration, Instant};
-use thiserror::Error;
-
-/// Why a scene cannot be turned into a world.
-#[derive(Debug, Error)]
-pub enum WorldError {
-    /// The stone's shape could not be built (a mesh that does not load, …).
-    #[error("stone shape: {0}")]
-    Shape(#[from] GeometryError),
-    /// A material's stack is invalid.
-    #[error("material `{name}`: {source}")]
-    Material {
-        /// Its name.
-        name: String,
-        /// What is wrong.
-        source: StackError,
-    },
-    /// The environment map could not be read.
-    #[error("environment map: {0}")]
-    Environment(#[from] ImageError),
-    /// A translucent body on a mesh that is not closed and consistently wound: its inside is
-    /// undefined.
-    #[error(
-        "the stone's mesh has {0} open or inconsistently wound edges: a translucent body needs a \
-         closed mesh whose triangles are all wound counter-clockwise seen from outside"
-    )]
-    OpenBody(usize),
-    /// The deadline passed or the cancel flag was set before the world was built.
-    #[error("stopped during setup: nothing rendered, nothing written")]
-    Stopped,
-}
-
-/// How a world is built: when to give up, and whether to show its progress.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct Setup<'a> {
-    /// Give up (with [`WorldError::Stopped`]) once this instant has passed.
-    pub deadline: Option<Instant>,
-    /// Give up once this is set (Ctrl-C).
-    pub cancel: Option<&'a AtomicBool>,
-    /// Show a progress bar on standard error (only on a terminal) once building the material
-    /// tables has taken more than [`PROGRESS_AFTER`].
-    pub progress: bool,
-}
-
-/// How long table building runs before its progress bar appears.
-pub const PROGRESS_AFTER: Duration = Duration::from_secs(1);
-
-impl Setup<'_> {
-    /// Whether to give up now.
-    fn stopped(&self) -> bool {
-        self.cancel.is_some_and(|c| c.load(Ordering::Relaxed))
-            || self.deadline.is_some_and(|d| Instant::now() >= d)
-    }
-
-    /// `Err(Stopped)` when it is time to give up.
-    fn check(&self) -> Result<(), WorldError> {
-        if self.stopped() {
-            Err(WorldError::Stopped)
-        } else {
-            Ok(())
-        }
-    }
-}
+use std::time::Instant;
 
 /// What a ray hit first.
 #[derive(Clone, Copy, Debug)]
@@ -393,6 +331,20 @@ impl World {
             }
             _ => None,
         };
+        let platelets = match body {
+            Some(b)
+                if shows_body
+                    && scene.effects.on(Effect::Platelets)
+                    && stage.render.platelets_explicit =>
+            {
+                b.platelets.clone()
+            }
+            _ => vec![],
+        };
+        // Every walk inside the stone must fit the walk's cell budget.
+        let (object_lo, object_hi) = stone.solid().bounds();
+        crate::platelet::grid::check_span(&platelets, object_lo, object_hi)?;
+
         Ok(World {
             stone,
             ground,
@@ -406,16 +358,7 @@ impl World {
             camera_medium,
             medium_depth: stage.render.medium_depth,
             transmission_off: scene.effects.forced(Effect::Transmission) == Some(false),
-            platelets: match body {
-                Some(b)
-                    if shows_body
-                        && scene.effects.on(Effect::Platelets)
-                        && stage.render.platelets_explicit =>
-                {
-                    b.platelets.clone()
-                }
-                _ => vec![],
-            },
+            platelets,
             flakes: match body {
                 Some(b)
                     if shows_body

@@ -132,6 +132,14 @@ impl Rng {
         self.state = self.state.wrapping_add(0x9e37_79b9_7f4a_7c15);
         mix64(self.state)
     }
+    /// Skips the next `n` numbers of the stream (what `n` calls of [`Rng::next_u64`] would do,
+    /// without mixing them).
+    #[inline]
+    pub fn skip(&mut self, n: u64) {
+        self.state = self
+            .state
+            .wrapping_add(n.wrapping_mul(0x9e37_79b9_7f4a_7c15));
+    }
     /// Next uniform number in `[0, 1)`.
     #[inline]
     pub fn uniform(&mut self) -> f32 {
@@ -170,6 +178,16 @@ mod tests {
             .collect();
         assert_eq!(a, b);
         assert_ne!(a, c);
+    }
+
+    #[test]
+    fn skip_is_drawing_and_discarding() {
+        let (mut a, mut b) = (Rng::new(9), Rng::new(9));
+        for _ in 0..3 {
+            a.next_u64();
+        }
+        b.skip(3);
+        assert_eq!(a.next_u64(), b.next_u64());
     }
 
     #[test]

@@ -43,6 +43,7 @@
 //! Render-level knobs (spp, sampler, maximum depth) live in the render settings; [`Knobs`] bundles
 //! them with an [`Accuracy`] for `tradeoff` settings written as `key=value,key=value`.
 
+pub(crate) use super::apply::stack_calls;
 use super::{Effect, Scene};
 use crate::bsdf::names::UnknownName;
 use crate::bsdf::{Distribution, FresnelMode, Masking, Model, StackDesc};
@@ -396,70 +397,6 @@ impl fmt::Display for Knobs {
         } else {
             f.write_str(&parts.join(","))
         }
-    }
-}
-
-/// Which effects a material calls for: the first absorbing coat, and whether the `t` term applies.
-pub(crate) fn stack_calls(stack: &StackDesc) -> (Option<usize>, bool) {
-    let absorbing = stack
-        .coats
-        .iter()
-        .position(|c| c.thickness > 0.0 && c.absorption.max_channel() > 0.0);
-    let t_term = !stack.coats.is_empty()
-        && stack.t_term.unwrap_or(matches!(stack.model, Model::Course))
-        && !matches!(stack.model, Model::Reference(_));
-    (absorbing, t_term)
-}
-
-impl Scene {
-    /// Applies accuracy knobs: rewrites every material's model and Fresnel mode, recounts which
-    /// materials call for absorption and the `t` term, and forces the chosen effects. `by` names
-    /// where the knobs came from (`command line`, `render.accuracy`), for `lapidary info`.
-    ///
-    /// Fails (changing nothing) when an effect this version cannot simulate is forced on.
-    pub fn set_accuracy(&mut self, acc: &Accuracy, by: &str) -> Result<(), KnobError> {
-        if let Some((e, _)) = acc.effects.iter().find(|(e, on)| *on && !e.implemented()) {
-            return Err(KnobError(format!(
-                "{e} cannot be forced on: this version does not simulate it"
-            )));
-        }
-        if acc.is_default() {
-            return Ok(());
-        }
-        for stack in &mut self.surface.stacks {
-            acc.apply_to(stack);
-        }
-        self.effects.clear(Effect::Absorption);
-        self.effects.clear(Effect::TTerm);
-        for (k, stack) in self.surface.stacks.iter().enumerate() {
-            if !self.surface.used[k] {
-                continue;
-            }
-            let name = &self.surface.names[k];
-            let (absorbing, t_term) = stack_calls(stack);
-            if let Some(i) = absorbing {
-                self.effects.turn_on(
-                    Effect::Absorption,
-                    format!("material \"{name}\" coats[{i}]"),
-                );
-            }
-            if t_term {
-                self.effects.turn_on(
-                    Effect::TTerm,
-                    format!(
-                        "material \"{name}\" ({:#} model, knobs from {by})",
-                        stack.model
-                    ),
-                );
-            }
-        }
-        for &(e, on) in &acc.effects {
-            self.effects.force(e, on, by);
-            self.accuracy.force(e, on);
-        }
-        self.accuracy.model = acc.model.or(self.accuracy.model);
-        self.accuracy.fresnel = acc.fresnel.or(self.accuracy.fresnel);
-        Ok(())
     }
 }
 

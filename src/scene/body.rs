@@ -79,6 +79,25 @@ impl Body {
         }
     }
 
+    /// Every platelet entry with the material of its faces, in recipe order: population index,
+    /// entry index, material name and description. `body_index` is the surface's
+    /// (`Surface::body_index`): the populations' material indices start one past it.
+    pub fn platelet_entries(
+        &self,
+        body_index: u32,
+    ) -> impl Iterator<Item = (usize, usize, &str, &StackDesc)> {
+        self.platelets.iter().enumerate().flat_map(move |(k, pop)| {
+            pop.entries
+                .iter()
+                .enumerate()
+                .filter_map(move |(j, &(_, m))| {
+                    let i = m.checked_sub(body_index)?.checked_sub(1)? as usize;
+                    let (name, stack) = self.platelet_materials.get(i)?;
+                    Some((k, j, name.as_str(), stack))
+                })
+        })
+    }
+
     /// Whether the interior absorbs or scatters at all (the `medium` effect).
     pub fn has_medium(&self) -> bool {
         self.medium

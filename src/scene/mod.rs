@@ -6,6 +6,7 @@
 //! which optional parts of the simulation the scene calls for, and why.
 
 pub mod accuracy;
+mod apply;
 pub mod body;
 pub mod effects;
 pub mod stage;

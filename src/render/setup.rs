@@ -1,0 +1,74 @@
+//! What building a [`super::World`] can fail with, and how it is built: when to give up, and
+//! whether to show progress.
+
+use crate::bsdf::StackError;
+use crate::geometry::GeometryError;
+use crate::image::ImageError;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+use thiserror::Error;
+
+/// Why a scene cannot be turned into a world.
+#[derive(Debug, Error)]
+pub enum WorldError {
+    /// The stone's shape could not be built (a mesh that does not load, …).
+    #[error("stone shape: {0}")]
+    Shape(#[from] GeometryError),
+    /// A material's stack is invalid.
+    #[error("material `{name}`: {source}")]
+    Material {
+        /// Its name.
+        name: String,
+        /// What is wrong.
+        source: StackError,
+    },
+    /// The environment map could not be read.
+    #[error("environment map: {0}")]
+    Environment(#[from] ImageError),
+    /// A translucent body on a mesh that is not closed and consistently wound: its inside is
+    /// undefined.
+    #[error(
+        "the stone's mesh has {0} open or inconsistently wound edges: a translucent body needs a \
+         closed mesh whose triangles are all wound counter-clockwise seen from outside"
+    )]
+    OpenBody(usize),
+    /// A walk of the body's explicit platelets could not cover the stone (its diagonal spans more
+    /// cells of a population than a walk visits).
+    #[error(transparent)]
+    PlateletSpan(#[from] crate::platelet::grid::SpanError),
+    /// The deadline passed or the cancel flag was set before the world was built.
+    #[error("stopped during setup: nothing rendered, nothing written")]
+    Stopped,
+}
+
+/// How a world is built: when to give up, and whether to show its progress.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Setup<'a> {
+    /// Give up (with [`WorldError::Stopped`]) once this instant has passed.
+    pub deadline: Option<Instant>,
+    /// Give up once this is set (Ctrl-C).
+    pub cancel: Option<&'a AtomicBool>,
+    /// Show a progress bar on standard error (only on a terminal) once building the material
+    /// tables has taken more than [`PROGRESS_AFTER`].
+    pub progress: bool,
+}
+
+/// How long table building runs before its progress bar appears.
+pub const PROGRESS_AFTER: Duration = Duration::from_secs(1);
+
+impl Setup<'_> {
+    /// Whether to give up now.
+    pub(crate) fn stopped(&self) -> bool {
+        self.cancel.is_some_and(|c| c.load(Ordering::Relaxed))
+            || self.deadline.is_some_and(|d| Instant::now() >= d)
+    }
+
+    /// `Err(Stopped)` when it is time to give up.
+    pub(crate) fn check(&self) -> Result<(), WorldError> {
+        if self.stopped() {
+            Err(WorldError::Stopped)
+        } else {
+            Ok(())
+        }
+    }
+}
