@@ -219,7 +219,12 @@ fn walk(pop: &Population, ray: &Segment, best: &mut Option<PlateletHit>) {
                     let bit = 1 << (9 * (dx + 1) + 3 * (dy + 1) + dz + 1);
                     if generated & bit == 0 {
                         generated |= bit;
-                        let ci = [centre[0] + dx, centre[1] + dy, centre[2] + dz];
+                        // Wrapping: a ray far from the origin saturates the cell coordinates.
+                        let ci = [
+                            centre[0].wrapping_add(dx),
+                            centre[1].wrapping_add(dy),
+                            centre[2].wrapping_add(dz),
+                        ];
                         test_cell(pop, ray, ci, slack, best);
                     }
                 }
