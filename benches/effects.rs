@@ -13,7 +13,8 @@
 //! `medium` (issue 17: forced on, the free-flight code runs on every segment through a medium that
 //! neither absorbs nor scatters), and the shipped clear body without platelets
 //! `gems/tinted-glass-sphere.ron` for `platelets` (issue 18: every path segment inside the body
-//! passes the platelet code's test, forced on or off). Each is 64 × 48 pixels, 16 spp, Sobol', max depth 8
+//! passes the platelet code's test, forced on or off) and for `manifold-nee` (a smooth body
+//! where nothing inside scatters: no walk can start). Each is 64 × 48 pixels, 16 spp, Sobol', max depth 8
 //! (`LAPIDARY_BENCH_SIZE=W` renders W × 3W/4), on one worker thread; the world is built outside
 //! the timed closure.
 //!
@@ -124,6 +125,9 @@ fn scenes() -> Vec<(Effect, Scene)> {
         (Effect::Transmission, gem("sunstone.ron")),
         (Effect::Medium, gem("sunstone.ron")),
         (Effect::Platelets, gem("tinted-glass-sphere.ron")),
+        // A smooth clear body under the studio's lights: nothing inside scatters, so the walk
+        // has no vertex to start from.
+        (Effect::ManifoldNee, gem("tinted-glass-sphere.ron")),
     ]
 }
 

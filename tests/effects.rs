@@ -632,6 +632,27 @@ fn platelet_code_changes_nothing_for_gems_without_platelets() {
 }
 
 #[test]
+fn manifold_code_changes_nothing_where_no_walk_can_start() {
+    // Issue 18: manifold next-event estimation starts only at platelets and medium scattering
+    // points inside a smooth boundary. An opaque gem, a smooth clear body (nothing inside
+    // scatters) and a rough scattering body render bit-identically with it forced on or off.
+    let mut failures = vec![];
+    for name in ["sunstone.ron", "tinted-glass-sphere.ron", "milky-stone.ron"] {
+        let s = gem(name);
+        assert!(!s.effects.called(Effect::ManifoldNee), "{name} calls for the walk");
+        failures.extend(untouched(Effect::ManifoldNee, name, &s));
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn manifold_forced_off_changes_a_gem_that_calls_for_it() {
+    let s = gem("oregon-sunstone.ron");
+    assert!(s.effects.called(Effect::ManifoldNee));
+    assert_live(Effect::ManifoldNee, "oregon-sunstone.ron", &s);
+}
+
+#[test]
 fn a_body_the_surface_never_shows_changes_nothing() {
     // The recipe has a `body` (with an absorbing, scattering medium), but the map never shows
     // `Body`: the stone is opaque (a compile warning says so), nothing calls for transmission or
