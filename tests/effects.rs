@@ -639,7 +639,10 @@ fn manifold_code_changes_nothing_where_no_walk_can_start() {
     let mut failures = vec![];
     for name in ["sunstone.ron", "tinted-glass-sphere.ron", "milky-stone.ron"] {
         let s = gem(name);
-        assert!(!s.effects.called(Effect::ManifoldNee), "{name} calls for the walk");
+        assert!(
+            !s.effects.called(Effect::ManifoldNee),
+            "{name} calls for the walk"
+        );
         failures.extend(untouched(Effect::ManifoldNee, name, &s));
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));

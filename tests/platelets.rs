@@ -84,10 +84,10 @@ mod energy;
 mod flights;
 #[path = "platelets/hard.rs"]
 mod hard;
-#[path = "platelets/manifold.rs"]
-mod manifold;
 #[path = "platelets/knobs.rs"]
 mod knobs;
+#[path = "platelets/manifold.rs"]
+mod manifold;
 #[path = "platelets/order.rs"]
 mod order;
 #[path = "platelets/stats.rs"]

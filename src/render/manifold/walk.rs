@@ -1,0 +1,321 @@
+//! The manifold walk: Newton's method on the direction at the vertex, and the measure of the
+//! connection it finds (module docs in [`super`]).
+
+use crate::bsdf::refract;
+use crate::geometry::{Frame, Ray, StoneHit};
+use crate::render::world::World;
+use glam::{Vec2, Vec3};
+
+/// Most Newton iterations of one walk.
+pub const MAX_ITERATIONS: u32 = 24;
+/// Largest change of direction per Newton step, radians.
+pub const MAX_STEP: f32 = 0.2;
+/// The walk has converged when the refracted direction is within this angle (radians) of the
+/// direction to the light point.
+pub const TOLERANCE: f32 = 1e-5;
+/// Finite-difference step of the constraint's Jacobian, radians.
+const FD_STEP: f32 = 1e-3;
+/// Most halvings of one Newton step while the residual grows.
+const MAX_HALVINGS: u32 = 6;
+
+/// Where a direction from the vertex leaves the stone.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Exit {
+    /// The boundary point `x1`, world space.
+    pub p: Vec3,
+    /// Object-space `x1` (for the surface map).
+    pub p_object: Vec3,
+    /// Unit geometric normal at `x1`, out of the stone.
+    pub ng: Vec3,
+    /// Unit shading normal at `x1`, out of the stone (Snell's law uses it, as the boundary BSDF).
+    pub n: Vec3,
+    /// Distance from the vertex to `x1`, world units.
+    pub t: f32,
+    /// The refracted direction leaving `x1` outward (unit).
+    pub out: Vec3,
+    /// Cosine between the direction inside and `n` (> 0).
+    pub cos_inside: f32,
+}
+
+/// A refracted connection from a vertex to a point on a light.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Connection {
+    /// Unit direction at the vertex, world space.
+    pub d: Vec3,
+    /// Where it leaves the stone.
+    pub exit: Exit,
+    /// Distance from `x1` to the light point, world units.
+    pub dist: f32,
+    /// `|dω0/dA2|`: solid angle at the vertex per unit light area, world units⁻².
+    pub jacobian: f32,
+}
+
+/// The first boundary point along `(x0, d)` and the direction refracted out of it; `None` if the
+/// ray does not leave the stone there (no hit, it enters instead, or total internal reflection).
+///
+/// # Arguments
+/// * `eta` – IOR inside over outside.
+pub fn exit(world: &World, x0: Vec3, d: Vec3, eta: f32) -> Option<Exit> {
+    let (h, cos_inside) = boundary(world, x0, d)?;
+    // `refract` takes the direction away from the surface on the incident side.
+    let out = refract(-d, h.ns, eta)?;
+    Some(Exit {
+        p: h.p,
+        p_object: h.p_object,
+        ng: h.ng,
+        n: h.ns,
+        t: h.t,
+        out,
+        cos_inside,
+    })
+}
+
+/// The boundary point the ray `(x0, d)` leaves the stone through, and `cos` of `d` with its
+/// shading normal (> 0).
+#[inline]
+pub(super) fn boundary(world: &World, x0: Vec3, d: Vec3) -> Option<(StoneHit, f32)> {
+    let h = world.stone.intersect(&Ray::new(x0, d), f32::INFINITY)?;
+    let c = h.ns.dot(d);
+    (h.ng.dot(d) > 0.0 && c > 0.0).then_some((h, c))
+}
+
+/// The constraint at direction `d`: the tangential part (3-D, perpendicular to the shading normal
+/// at `x1(d)`) of the generalised half-vector `η d − u`, with `u` the unit direction from `x1` to
+/// `x2` — zero exactly where Snell's law bends `d` onto `u` — and the boundary hit.
+#[inline]
+fn constraint(world: &World, x0: Vec3, d: Vec3, x2: Vec3, eta: f32) -> Option<(Vec3, StoneHit)> {
+    let (h, _) = boundary(world, x0, d)?;
+    let u = (x2 - h.p).try_normalize()?;
+    let v = eta * d - u;
+    Some((v - h.ns * v.dot(h.ns), h))
+}
+
+/// `d` turned by the tangent coordinates `a` (radians, small) in `frame` (whose normal is `d`).
+#[inline]
+fn turn(frame: &Frame, a: Vec2) -> Vec3 {
+    (frame.n + frame.s * a.x + frame.t * a.y).normalize()
+}
+
+/// `∂C/∂a` in the coordinates `basis`: columns for the two tangent directions of `d`, by forward
+/// (`central: false`, with `c0` the constraint at `d`) or central differences. `None` if a
+/// perturbed ray does not leave the stone.
+#[allow(clippy::too_many_arguments)]
+fn constraint_jacobian(
+    world: &World,
+    x0: Vec3,
+    d: Vec3,
+    x2: Vec3,
+    eta: f32,
+    basis: (Vec3, Vec3),
+    c0: Vec3,
+    central: bool,
+) -> Option<[[f32; 2]; 2]> {
+    let f = Frame::from_normal(d);
+    let mut j = [[0.0; 2]; 2];
+    for (col, dir) in [Vec2::X, Vec2::Y].into_iter().enumerate() {
+        let plus = constraint(world, x0, turn(&f, dir * FD_STEP), x2, eta)?.0;
+        let diff = if central {
+            let minus = constraint(world, x0, turn(&f, -dir * FD_STEP), x2, eta)?.0;
+            (plus - minus) / (2.0 * FD_STEP)
+        } else {
+            (plus - c0) / FD_STEP
+        };
+        j[0][col] = diff.dot(basis.0);
+        j[1][col] = diff.dot(basis.1);
+    }
+    Some(j)
+}
+
+#[inline]
+fn det(j: &[[f32; 2]; 2]) -> f32 {
+    j[0][0] * j[1][1] - j[0][1] * j[1][0]
+}
+
+/// Solves for the refracted connection from `x0` (inside the stone) to `x2` (a light point whose
+/// emitting plane has unit normal `n_light`); `None` if the walk does not converge.
+///
+/// Seeded with the straight line `x0 → x2`; if Newton's method fails from there, it follows the
+/// solution from `η = 1`, where the straight line is exact, through [`STAGES`] increasing indices
+/// to `eta` (a continuation: each stage starts from the last one's solution).
+///
+/// # Arguments
+/// * `eta` – the boundary's IOR inside over outside.
+pub fn solve(world: &World, x0: Vec3, x2: Vec3, n_light: Vec3, eta: f32) -> Option<Connection> {
+    let seed = (x2 - x0).try_normalize()?;
+    let d = match newton(world, x0, x2, eta, seed, TOLERANCE) {
+        Some(d) => d,
+        None => {
+            let mut d = seed;
+            for k in 1..=STAGES {
+                let eta_k = 1.0 + (eta - 1.0) * k as f32 / STAGES as f32;
+                let tol = if k == STAGES {
+                    TOLERANCE
+                } else {
+                    STAGE_TOLERANCE
+                };
+                d = newton(world, x0, x2, eta_k, d, tol)?;
+            }
+            d
+        }
+    };
+    let e = exit(world, x0, d, eta)?;
+    let to_light = x2 - e.p;
+    let dist = to_light.length();
+    // Snell's law holds and the refracted ray really heads for the light.
+    if e.out.dot(to_light) < dist * (1.0 - 1e-3) {
+        return None;
+    }
+    let jacobian = jacobian(world, x0, d, x2, n_light, eta)?;
+    Some(Connection {
+        d,
+        exit: e,
+        dist,
+        jacobian,
+    })
+}
+
+/// Stages of the continuation in the index.
+pub const STAGES: u32 = 4;
+/// Convergence of an intermediate stage.
+const STAGE_TOLERANCE: f32 = 1e-3;
+
+/// Newton's method on the direction at `x0` from `seed` (module docs) with Broyden's rank-one
+/// updates of the Jacobian (Broyden, "A class of methods for solving nonlinear simultaneous
+/// equations", Math. Comp. 19, 1965): the finite-difference Jacobian is taken once at the seed
+/// (two ray casts) and then updated from each step's change of the constraint, so an iteration
+/// costs one cast; where a step fails to lower the constraint even when halved, the Jacobian is
+/// taken afresh by differences, once per failure. The coordinates stay those of the seed: `d` in
+/// the tangent frame of `seed`, the constraint in the tangent basis of the seed's boundary point.
+/// Returns the converged direction, or `None`.
+fn newton(world: &World, x0: Vec3, x2: Vec3, eta: f32, seed: Vec3, tolerance: f32) -> Option<Vec3> {
+    let frame = Frame::from_normal(seed);
+    let (mut c, h) = constraint(world, x0, seed, x2, eta)?;
+    let b = Frame::from_normal(h.ns);
+    let basis = (b.s, b.t);
+    let coords = |c: Vec3| Vec2::new(c.dot(basis.0), c.dot(basis.1));
+    let mut a = Vec2::ZERO;
+    let mut d = seed;
+    let mut j = constraint_jacobian(world, x0, d, x2, eta, basis, c, false)?;
+    let mut fresh = true;
+    for _ in 0..MAX_ITERATIONS {
+        if c.length() < tolerance {
+            return Some(d);
+        }
+        let dt = det(&j);
+        let r = coords(c);
+        let mut step = if dt.abs() > 1e-12 && dt.is_finite() {
+            -Vec2::new(j[1][1] * r.x - j[0][1] * r.y, j[0][0] * r.y - j[1][0] * r.x) / dt
+        } else {
+            Vec2::ZERO
+        };
+        if step.length() > MAX_STEP {
+            step *= MAX_STEP / step.length();
+        }
+        let mut accepted = None;
+        if step.length() > 0.0 {
+            for _ in 0..=MAX_HALVINGS {
+                let trial = turn(&frame, a + step);
+                if let Some((ct, _)) = constraint(world, x0, trial, x2, eta)
+                    && ct.length() < c.length()
+                {
+                    accepted = Some((trial, ct));
+                    break;
+                }
+                step *= 0.5;
+            }
+        }
+        match accepted {
+            Some((trial, ct)) => {
+                // Broyden: J += (Δr − J Δa) Δaᵀ / |Δa|².
+                let dr = coords(ct) - r;
+                let jda = Vec2::new(
+                    j[0][0] * step.x + j[0][1] * step.y,
+                    j[1][0] * step.x + j[1][1] * step.y,
+                );
+                let k = (dr - jda) / step.length_squared();
+                j[0][0] += k.x * step.x;
+                j[0][1] += k.x * step.y;
+                j[1][0] += k.y * step.x;
+                j[1][1] += k.y * step.y;
+                (a, d, c) = (a + step, trial, ct);
+                fresh = false;
+            }
+            // A step from a fresh Jacobian that cannot lower the constraint: give up.
+            None if fresh => return None,
+            None => {
+                j = finite_difference_at(world, x0, &frame, a, x2, eta, basis, c)?;
+                fresh = true;
+            }
+        }
+    }
+    (c.length() < tolerance).then_some(d)
+}
+
+/// The forward-difference Jacobian of the constraint in the seed's coordinates at `a` (the
+/// constraint there is `c`).
+#[allow(clippy::too_many_arguments)]
+fn finite_difference_at(
+    world: &World,
+    x0: Vec3,
+    frame: &Frame,
+    a: Vec2,
+    x2: Vec3,
+    eta: f32,
+    basis: (Vec3, Vec3),
+    c: Vec3,
+) -> Option<[[f32; 2]; 2]> {
+    let mut j = [[0.0; 2]; 2];
+    for (col, dir) in [Vec2::X, Vec2::Y].into_iter().enumerate() {
+        let plus = constraint(world, x0, turn(frame, a + dir * FD_STEP), x2, eta)?.0;
+        let diff = (plus - c) / FD_STEP;
+        j[0][col] = diff.dot(basis.0);
+        j[1][col] = diff.dot(basis.1);
+    }
+    Some(j)
+}
+
+/// `|dω0/dA2|` (world units⁻²) of the refracted path from `x0` along `d` to the light point `x2`
+/// (module docs): `|det ∂C/∂x2| / |det ∂C/∂d|` in the tangent basis at `x1`, `∂C/∂x2` in closed
+/// form on the light's plane and `∂C/∂d` by central differences. `None` if a perturbed ray does
+/// not leave the stone or the map is singular.
+pub fn jacobian(
+    world: &World,
+    x0: Vec3,
+    d: Vec3,
+    x2: Vec3,
+    n_light: Vec3,
+    eta: f32,
+) -> Option<f32> {
+    let (h, _) = boundary(world, x0, d)?;
+    let to_light = x2 - h.p;
+    let l = to_light.length();
+    let u = to_light / l;
+    let b = Frame::from_normal(h.ns);
+    let basis = (b.s, b.t);
+    let jd = constraint_jacobian(world, x0, d, x2, eta, basis, Vec3::ZERO, true)?;
+    // ∂C/∂x2 = −P_tangent (I − u uᵀ) / L on the light's plane (axes a, b).
+    let light = Frame::from_normal(n_light);
+    let col = |e: Vec3| -(e - u * u.dot(e)) / l;
+    let (ca, cb) = (col(light.s), col(light.t));
+    let jx = [
+        [ca.dot(basis.0), cb.dot(basis.0)],
+        [ca.dot(basis.1), cb.dot(basis.1)],
+    ];
+    let jac = det(&jx).abs() / det(&jd).abs();
+    (jac.is_finite() && jac > 0.0).then_some(jac)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn turn_moves_by_the_tangent_angle() {
+        let f = Frame::from_normal(Vec3::new(0.3, -0.2, 0.9).normalize());
+        let d = turn(&f, Vec2::new(1e-3, 0.0));
+        // The angle from its sine (acos near 1 loses the digits in f32).
+        let angle = d.cross(f.n).length().asin();
+        assert!((angle - 1e-3).abs() < 2e-6, "{angle}");
+        assert!(d.dot(f.s) > 0.0);
+    }
+}
