@@ -390,7 +390,7 @@ impl Compiler<'_> {
             .library
             .position_of(name)
             .unwrap_or_else(|| "?".into());
-        let (absorbing, t_term) = crate::scene::accuracy::stack_calls(stack);
+        let (absorbing, t_term) = crate::scene::stack_calls(stack);
         if let Some(i) = absorbing {
             self.effects
                 .turn_on(Effect::Absorption, format!("{element} coats[{i}] ({file})"));

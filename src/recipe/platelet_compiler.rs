@@ -6,8 +6,10 @@ use super::map_compiler::Compiler;
 use super::platelets::OrientationDesc;
 use super::surface::FieldDesc;
 use crate::bsdf::StackDesc;
+use crate::geometry::Shape;
 use crate::platelet::{Modulation, Orientation, Population};
 use crate::sampler::hash_words;
+use crate::scene::Stage;
 use glam::Vec3;
 
 impl Compiler<'_> {
@@ -148,5 +150,31 @@ impl Compiler<'_> {
             ));
         }
         Ok(m)
+    }
+}
+
+impl Compiler<'_> {
+    /// Records an error at the population when a walk of its explicit platelets could not cover
+    /// the stone ([`crate::platelet::grid::check_span`]); only the analytic shapes, whose size is
+    /// known here (a mesh is checked when the world is built).
+    pub(super) fn check_platelet_span(&mut self, body: &crate::scene::Body, stage: &Stage) {
+        if !stage.render.platelets_explicit || matches!(stage.shape, Shape::Mesh { .. }) {
+            return;
+        }
+        let Ok(solid) = crate::geometry::Solid::new(&stage.shape) else {
+            return;
+        };
+        let (lo, hi) = solid.bounds();
+        if let Err(e) = crate::platelet::grid::check_span(&body.platelets, lo, hi) {
+            let r = self.recipe;
+            let list = r
+                .source
+                .find(&["body", ":"])
+                .and_then(|b| r.source.find_from(b, &["platelets", ":"]));
+            let at = list
+                .and_then(|l| r.source.nth_element(l, e.population))
+                .or(list);
+            self.errors.push(r.source.error(at, e.to_string()));
+        }
     }
 }

@@ -26,8 +26,6 @@
 //! cannot exceed 0 anywhere (an empty population) is an error.
 
 use super::surface::FieldDesc;
-use crate::geometry::Shape;
-use crate::scene::Stage;
 use serde::{Deserialize, Deserializer, Serialize};
 
 /// Most populations a body may hold.
@@ -108,30 +106,4 @@ pub struct PlateletsDesc {
     /// (dimensionless), multiplies `density` at each point (default: none, uniform density).
     #[serde(default)]
     pub modulation: Option<FieldDesc>,
-}
-
-impl super::map_compiler::Compiler<'_> {
-    /// Records an error at the population when a walk of its explicit platelets could not cover
-    /// the stone ([`crate::platelet::grid::check_span`]); only the analytic shapes, whose size is
-    /// known here (a mesh is checked when the world is built).
-    pub(super) fn check_platelet_span(&mut self, body: &crate::scene::Body, stage: &Stage) {
-        if !stage.render.platelets_explicit || matches!(stage.shape, Shape::Mesh { .. }) {
-            return;
-        }
-        let Ok(solid) = crate::geometry::Solid::new(&stage.shape) else {
-            return;
-        };
-        let (lo, hi) = solid.bounds();
-        if let Err(e) = crate::platelet::grid::check_span(&body.platelets, lo, hi) {
-            let r = self.recipe;
-            let list = r
-                .source
-                .find(&["body", ":"])
-                .and_then(|b| r.source.find_from(b, &["platelets", ":"]));
-            let at = list
-                .and_then(|l| r.source.nth_element(l, e.population))
-                .or(list);
-            self.errors.push(r.source.error(at, e.to_string()));
-        }
-    }
 }

@@ -43,7 +43,6 @@
 //! Render-level knobs (spp, sampler, maximum depth) live in the render settings; [`Knobs`] bundles
 //! them with an [`Accuracy`] for `tradeoff` settings written as `key=value,key=value`.
 
-pub(crate) use super::apply::stack_calls;
 use super::{Effect, Scene};
 use crate::bsdf::names::UnknownName;
 use crate::bsdf::{Distribution, FresnelMode, Masking, Model, StackDesc};
@@ -439,6 +438,7 @@ mod tests {
     fn apply_rewrites_materials() {
         use crate::bsdf::{Base, Coat};
         use crate::color::Rgb;
+        use crate::scene::stack_calls;
         let coat = Coat {
             ior: 1.5,
             roughness: 10.0,

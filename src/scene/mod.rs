@@ -7,6 +7,7 @@
 
 pub mod accuracy;
 mod apply;
+pub(crate) use apply::stack_calls;
 pub mod body;
 pub mod effects;
 pub mod stage;
