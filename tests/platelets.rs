@@ -46,9 +46,9 @@
 //!    rays and rays leaving a disc, ≈ 39 000 queries over five populations and all five together;
 //!    a stone whose diagonal spans more cells than a walk visits is an error, not a short walk.
 //! 10. [`knobs`] — platelet faces call for effects (an absorbing coat turns `absorption` on,
-//!    credited to `body.platelets[k] entry j`, as `lapidary info` prints) and the accuracy knobs
-//!    rewrite them (`model=course`, `absorption=off`), from the recipe and through
-//!    `Scene::set_accuracy`.
+//!     credited to `body.platelets[k] entry j`, as `lapidary info` prints) and the accuracy knobs
+//!     rewrite them (`model=course`, `absorption=off`), from the recipe and through
+//!     `Scene::set_accuracy`.
 //!
 //! **Finding (fixed): paths lost at the boundary.** A ray leaving a platelet was offset from the
 //! disc along its normal; on a disc the boundary cuts, a hit within that offset (2e-5) of the
