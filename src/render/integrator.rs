@@ -351,7 +351,10 @@ where
             // hit is kept off the boundary ahead like a scattering point (a hit on a disc the
             // boundary cuts can lie within rounding of it; the move, at most the spawn offset,
             // may put the origin behind the disc it leaves, which the ray then passes).
-            Hit::Platelet { p, .. } => keep_off_the_boundary(p, &ray, hidden.as_ref()),
+            // (Already computed where the walk ran from the platelet.)
+            Hit::Platelet { p, .. } => {
+                walk.unwrap_or_else(|| keep_off_the_boundary(p, &ray, hidden.as_ref()))
+            }
             _ => offset_origin(sb.p, sb.ng, bs.wi),
         };
         ray = Ray::in_medium(origin, bs.wi, path.medium);

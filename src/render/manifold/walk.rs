@@ -165,7 +165,7 @@ pub fn solve(world: &World, x0: Vec3, x2: Vec3, n_light: Vec3, eta: f32) -> Opti
     if e.out.dot(to_light) < dist * (1.0 - 1e-3) {
         return None;
     }
-    let jacobian = jacobian(world, x0, d, x2, n_light, eta)?;
+    let jacobian = measure(world, x0, d, x2, n_light, eta, e.p, e.n)?;
     Some(Connection {
         d,
         exit: e,
@@ -287,10 +287,25 @@ pub fn jacobian(
     eta: f32,
 ) -> Option<f32> {
     let (h, _) = boundary(world, x0, d)?;
-    let to_light = x2 - h.p;
+    measure(world, x0, d, x2, n_light, eta, h.p, h.ns)
+}
+
+/// [`jacobian`] where the boundary point `x1` and its shading normal `n1` along `d` are known.
+#[allow(clippy::too_many_arguments)]
+fn measure(
+    world: &World,
+    x0: Vec3,
+    d: Vec3,
+    x2: Vec3,
+    n_light: Vec3,
+    eta: f32,
+    x1: Vec3,
+    n1: Vec3,
+) -> Option<f32> {
+    let to_light = x2 - x1;
     let l = to_light.length();
     let u = to_light / l;
-    let b = Frame::from_normal(h.ns);
+    let b = Frame::from_normal(n1);
     let basis = (b.s, b.t);
     let jd = constraint_jacobian(world, x0, d, x2, eta, basis, Vec3::ZERO, true)?;
     // ∂C/∂x2 = −P_tangent (I − u uᵀ) / L on the light's plane (axes a, b).
