@@ -14,7 +14,8 @@
 //! neither absorbs nor scatters), and the shipped clear body without platelets
 //! `gems/tinted-glass-sphere.ron` for `platelets` (issue 18: every path segment inside the body
 //! passes the platelet code's test, forced on or off) and for `manifold-nee` (a smooth body
-//! where nothing inside scatters: no walk can start). Each is 64 × 48 pixels, 16 spp, Sobol', max depth 8
+//! where nothing inside scatters: no walk can start), and the rough-bodied `gems/milky-stone.ron`
+//! for `manifold-caustics` (the walk through the stone needs a smooth boundary). Each is 64 × 48 pixels, 16 spp, Sobol', max depth 8
 //! (`LAPIDARY_BENCH_SIZE=W` renders W × 3W/4), on one worker thread; the world is built outside
 //! the timed closure.
 //!
@@ -128,6 +129,8 @@ fn scenes() -> Vec<(Effect, Scene)> {
         // A smooth clear body under the studio's lights: nothing inside scatters, so the walk
         // has no vertex to start from.
         (Effect::ManifoldNee, gem("tinted-glass-sphere.ron")),
+        // A rough boundary: the walk through the stone needs a smooth one.
+        (Effect::ManifoldCaustics, gem("milky-stone.ron")),
     ]
 }
 

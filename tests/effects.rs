@@ -649,6 +649,29 @@ fn manifold_code_changes_nothing_where_no_walk_can_start() {
 }
 
 #[test]
+fn caustic_walk_changes_nothing_where_no_walk_can_start() {
+    // Issue 18: the walk through the stone starts only at the floor under a smooth body. An
+    // opaque gem and a rough scattering body render bit-identically with it forced on or off.
+    let mut failures = vec![];
+    for name in ["sunstone.ron", "milky-stone.ron"] {
+        let s = gem(name);
+        assert!(
+            !s.effects.called(Effect::ManifoldCaustics),
+            "{name} calls for the walk"
+        );
+        failures.extend(untouched(Effect::ManifoldCaustics, name, &s));
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn caustic_walk_forced_off_changes_a_gem_that_calls_for_it() {
+    let s = gem("tinted-glass-sphere.ron");
+    assert!(s.effects.called(Effect::ManifoldCaustics));
+    assert_live(Effect::ManifoldCaustics, "tinted-glass-sphere.ron", &s);
+}
+
+#[test]
 fn manifold_forced_off_changes_a_gem_that_calls_for_it() {
     let s = gem("oregon-sunstone.ron");
     assert!(s.effects.called(Effect::ManifoldNee));

@@ -76,6 +76,8 @@
 
 mod common;
 
+#[path = "platelets/caustics.rs"]
+mod caustics;
 #[path = "platelets/demand.rs"]
 mod demand;
 #[path = "platelets/energy.rs"]

@@ -353,9 +353,11 @@ impl Compiler<'_> {
     }
 
     /// Turns on manifold next-event estimation (issue 18) where it can help: a body the surface
-    /// shows, with a smooth boundary (the walk solves Snell's law at a specular interface), holding
-    /// platelets or a scattering medium (vertices inside that scatter light), under at least one
-    /// emitting area light (the walk connects to points on lights).
+    /// shows, with a smooth boundary (the walk solves Snell's law at a specular interface), under
+    /// at least one emitting area light (the walk connects to points on lights) — from inside
+    /// (`manifold-nee`) where the body holds platelets or a scattering medium (vertices inside
+    /// that scatter light), through the stone (`manifold-caustics`) where a floor receives its
+    /// caustic.
     fn manifold_effect(&mut self, body: &Body, stage: &crate::scene::stage::Stage) {
         let r = self.recipe;
         let scatters_inside = !body.platelets.is_empty()
@@ -376,6 +378,28 @@ impl Compiler<'_> {
                     } else {
                         "platelets"
                     },
+                    stage.lights.len()
+                ),
+            );
+        }
+        if self.effects.called(Effect::Transmission)
+            && body.alpha == 0.0
+            && lit
+            && let Some(g) = stage
+                .ground
+                .as_ref()
+                .filter(|g| g.albedo.max_channel() > 0.0)
+        {
+            let at = r.source.find(&["body", ":"]);
+            let e = r.source.error(at, "");
+            self.effects.turn_on(
+                Effect::ManifoldCaustics,
+                format!(
+                    "body ({}:{}): a smooth boundary over the stage's floor (y = {}), under {} area \
+                     light(s)",
+                    e.file,
+                    e.line,
+                    g.height,
                     stage.lights.len()
                 ),
             );

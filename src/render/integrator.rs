@@ -37,35 +37,30 @@
 //! offset along the disc's normal put the next ray outside the stone, where it met no boundary and
 //! bounced among the population's discs beyond the stone until `max_depth` (tests/platelets.rs).
 //!
+//! **Light through the boundary** (issue 18). At a platelet hit or a medium scattering point
+//! inside a smooth boundary, and at a floor hit under a smooth stone, a manifold walk samples a
+//! light through the boundary ([`super::manifold`]); `PathState::manifold` keeps the vertex while
+//! the BSDF-sampled continuation follows the walk's chain, so a light it reaches is weighted
+//! against the walk ([`super::direct::manifold_weight`]).
+//!
 //! **Variants.** [`trace`] is generic over the transported light `S` and monomorphised per variant
 //! ([`crate::spectrum`]); the film receives the path's radiance as a stored colour.
 //!
 //! **Sample dimensions.** The slot layout is [`crate::sampler`]'s (written once there).
 
+use super::direct::{Strategy, direct_light, emission_weight, manifold_weight};
 use super::manifold;
+use super::manifold::{Chain, WalkNumbers, WalkVertex};
 use super::path::{ManifoldVertex, PathSample, PathState};
-use super::shading::{SurfaceBsdf, shade};
+use super::shading::shade;
 use super::world::{Hit, LightRef, World};
-use crate::bsdf::{Bsdf, Bxdf, power_heuristic};
+use crate::bsdf::{Bsdf, Bxdf};
 use crate::geometry::ray::OFFSET_SCALE;
 use crate::geometry::{MediumId, Ray, offset_origin};
 use crate::medium::FreeFlight;
 use crate::sampler::{PixelSampler, slots};
 use crate::spectrum::Spectral;
 use glam::Vec3;
-
-/// Which estimators of direct light are used.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Strategy {
-    /// Light sampling and BSDF sampling, combined by the power heuristic.
-    #[default]
-    Mis,
-    /// Light sampling only: light reached by a BSDF-sampled ray is ignored (except from the
-    /// camera).
-    LightOnly,
-    /// BSDF sampling only: no shadow rays.
-    BsdfOnly,
-}
 
 /// Bounces after which Russian roulette may end a path.
 const RR_DEPTH: u32 = 3;
@@ -158,21 +153,26 @@ where
                     };
                     path.manifold = None;
                     if let Some(setup) = &world.manifold
+                        && setup.inside
                         && strategy != Strategy::BsdfOnly
                     {
                         let (u_light, u_point, u_more) =
                             (sampler.get1d(), sampler.get2d(), sampler.get2d());
-                        if let Some(ml) = manifold::sample_light::<S>(
-                            world,
-                            setup,
+                        let v = WalkVertex {
                             p,
-                            None,
-                            u_light,
-                            u_point,
-                            u_more.x,
-                            u_more.y,
-                            &path.lambda,
-                        ) {
+                            chain: Chain::Out,
+                            skip: None,
+                            ng: Vec3::ZERO,
+                        };
+                        let u = WalkNumbers {
+                            light: u_light,
+                            point: u_point,
+                            map: [u_more.x; 2],
+                            walk: u_more.y,
+                        };
+                        if let Some(ml) =
+                            manifold::sample_light::<S>(world, setup, &v, &u, &path.lambda)
+                        {
                             let f = phase.value(-ray.dir, ml.d);
                             let w = manifold_weight(strategy, ml.pdf, f * ml.cross, true);
                             let c = path.throughput() * ml.value * (f * w);
@@ -184,7 +184,8 @@ where
                             p,
                             d: ps.wi,
                             pdf: ps.pdf,
-                            crossed: false,
+                            chain: Chain::Out,
+                            crossings: 0,
                         });
                     }
                     path.scatter_in_medium(ps.pdf, p);
@@ -213,9 +214,10 @@ where
             Some(Hit::Light { index, t }) => {
                 let le = S::from_unbounded(world.areas[index].emitted(-ray.dir), &path.lambda);
                 let w = match (path.manifold, &world.manifold) {
-                    // One refraction out of the stone since a vertex where the walk ran.
-                    (Some(v), Some(setup)) if v.crossed => {
-                        let p_walk = manifold::density(world, setup, v.p, v.d, ray.at(t), index);
+                    // The walk's chain of refractions since a vertex where the walk ran.
+                    (Some(v), Some(setup)) if v.crossings == v.chain.crossings() => {
+                        let p_walk =
+                            manifold::density(world, setup, v.p, v.d, ray.at(t), index, v.chain);
                         manifold_weight(strategy, p_walk, v.pdf, false)
                     }
                     _ => emission_weight(world, strategy, &path, || {
@@ -261,38 +263,64 @@ where
                 world, strategy, &sb, wo_local, u_light, u_point, &mut path, &mut out,
             );
         }
-        // Manifold next-event estimation from a platelet: the light it sees through the boundary.
-        let walk = match (&world.manifold, &hit) {
-            (Some(setup), Hit::Platelet { id, .. })
-                if strategy != Strategy::BsdfOnly && !sb.flags().is_specular_only() =>
+        // Manifold next-event estimation from a platelet (the light it sees through the
+        // boundary) or from the floor (the light focused on it through the stone).
+        let start = match (&world.manifold, hit) {
+            _ if strategy == Strategy::BsdfOnly || sb.flags().is_specular_only() => None,
+            (Some(setup), Hit::Platelet { id, .. }) if setup.inside => {
+                let v = WalkVertex {
+                    p: keep_off_the_boundary(sb.p, &ray, hidden.as_ref()),
+                    chain: Chain::Out,
+                    skip: (id.population != u32::MAX).then_some(id),
+                    ng: Vec3::ZERO,
+                };
+                let walk = sampler.get1d();
+                let u = WalkNumbers {
+                    light: u_light,
+                    point: u_point,
+                    map: [u_switch; 2],
+                    walk,
+                };
+                Some((setup, v, u))
+            }
+            (Some(setup), Hit::Ground { .. })
+                if setup.through && path.medium == MediumId::OUTSIDE =>
             {
-                let x0 = keep_off_the_boundary(sb.p, &ray, hidden.as_ref());
-                let skip = (id.population != u32::MAX).then_some(*id);
-                let u_walk = sampler.get1d();
-                if let Some(ml) = manifold::sample_light::<S>(
-                    world,
-                    setup,
-                    x0,
-                    skip,
-                    u_light,
-                    u_point,
-                    u_switch,
-                    u_walk,
-                    &path.lambda,
-                ) && sb.admits(ml.d)
-                {
-                    let (wi_local, f) = sb.eval::<S>(wo_local, ml.d);
-                    let p_bsdf = sb.pdf::<S>(wo_local, wi_local) * ml.cross;
-                    let w = manifold_weight(strategy, ml.pdf, p_bsdf, true);
-                    let c = path.throughput() * f * ml.value * (wi_local.z.abs() * w);
-                    if c.is_valid() {
-                        path.l += c;
-                    }
-                }
-                Some(x0)
+                let v = WalkVertex {
+                    p: sb.p,
+                    chain: Chain::Through,
+                    skip: None,
+                    ng: sb.ng,
+                };
+                let (light, point, map, walk) = (
+                    sampler.get1d(),
+                    sampler.get2d(),
+                    sampler.get2d(),
+                    sampler.get1d(),
+                );
+                let u = WalkNumbers {
+                    light,
+                    point,
+                    map: map.into(),
+                    walk,
+                };
+                Some((setup, v, u))
             }
             _ => None,
         };
+        if let Some((setup, v, u)) = &start
+            && let Some(ml) = manifold::sample_light::<S>(world, setup, v, u, &path.lambda)
+            && sb.admits(ml.d)
+        {
+            let (wi_local, f) = sb.eval::<S>(wo_local, ml.d);
+            let p_bsdf = sb.pdf::<S>(wo_local, wi_local) * ml.cross;
+            let w = manifold_weight(strategy, ml.pdf, p_bsdf, true);
+            let c = path.throughput() * f * ml.value * (wi_local.z.abs() * w);
+            if c.is_valid() {
+                path.l += c;
+            }
+        }
+        let walk = start.map(|(_, v, _)| v);
 
         // Continue the path by sampling the BSDF.
         let uc = sampler.get1d();
@@ -307,14 +335,15 @@ where
         path.manifold = match (walk, path.manifold) {
             // A delta lobe at the vertex is not a direction the walk can produce.
             (Some(_), _) if bs.flags.is_specular() => None,
-            (Some(x0), _) => Some(ManifoldVertex {
-                p: x0,
+            (Some(v), _) => Some(ManifoldVertex {
+                p: v.p,
                 d: bs.wi,
                 pdf: bs.pdf,
-                crossed: false,
+                chain: v.chain,
+                crossings: 0,
             }),
             (None, Some(v))
-                if !v.crossed
+                if v.crossings < v.chain.crossings()
                     && matches!(hit, Hit::Stone(_))
                     && bs.flags.is_specular()
                     && bs.flags.is_transmission()
@@ -322,7 +351,7 @@ where
             {
                 Some(ManifoldVertex {
                     pdf: v.pdf * bs.pdf,
-                    crossed: true,
+                    crossings: v.crossings + 1,
                     ..v
                 })
             }
@@ -352,9 +381,9 @@ where
             // boundary cuts can lie within rounding of it; the move, at most the spawn offset,
             // may put the origin behind the disc it leaves, which the ray then passes).
             // (Already computed where the walk ran from the platelet.)
-            Hit::Platelet { p, .. } => {
-                walk.unwrap_or_else(|| keep_off_the_boundary(p, &ray, hidden.as_ref()))
-            }
+            Hit::Platelet { p, .. } => walk
+                .map(|v| v.p)
+                .unwrap_or_else(|| keep_off_the_boundary(p, &ray, hidden.as_ref())),
             _ => offset_origin(sb.p, sb.ng, bs.wi),
         };
         ray = Ray::in_medium(origin, bs.wi, path.medium);
@@ -383,109 +412,5 @@ fn keep_off_the_boundary(p: Vec3, ray: &Ray, found: Option<&Hit>) -> Vec3 {
         p - n * (eps - depth)
     } else {
         p
-    }
-}
-
-/// Next-event estimation at `sb`: one light sample, weighted against BSDF sampling by `strategy`.
-#[allow(clippy::too_many_arguments)]
-#[inline]
-fn direct_light<S: Spectral>(
-    world: &World,
-    strategy: Strategy,
-    sb: &SurfaceBsdf,
-    wo_local: Vec3,
-    u_light: f32,
-    u_point: glam::Vec2,
-    path: &mut PathState<S>,
-    out: &mut PathSample,
-) where
-    Bsdf: Bxdf<S>,
-{
-    let Some((light, p_pick)) = world.pick_light(u_light) else {
-        return;
-    };
-    let sample = match light {
-        LightRef::Area(i) => world.areas[i].sample(sb.p, u_point),
-        LightRef::Environment => world.environment.sample(u_point),
-    };
-    let Some(ls) = sample else {
-        return;
-    };
-    if !sb.admits(ls.wi) || (world.transmission_off && ls.wi.dot(sb.ng) < 0.0) {
-        return;
-    }
-    let (wi_local, f) = sb.eval::<S>(wo_local, ls.wi);
-    if f.is_black() {
-        return;
-    }
-    let origin = offset_origin(sb.p, sb.ng, ls.wi);
-    let t_max = if ls.dist.is_finite() {
-        (ls.dist - (origin - sb.p).length()) * (1.0 - 1e-4)
-    } else {
-        f32::INFINITY
-    };
-    out.rays += 1;
-    if world.occluded(&Ray::new(origin, ls.wi), t_max) {
-        return;
-    }
-    let p_light = p_pick * ls.pdf;
-    let w = match strategy {
-        Strategy::Mis => power_heuristic(p_light, sb.pdf::<S>(wo_local, wi_local)),
-        _ => 1.0,
-    };
-    let radiance = S::from_unbounded(ls.radiance, &path.lambda);
-    let c = path.throughput() * f * radiance * (wi_local.z.abs() * w / p_light);
-    if c.is_valid() {
-        path.l += c;
-    }
-}
-
-/// Weight of one of the two ways to a light through the boundary (module [`manifold`]):
-/// `p_walk` and `p_bsdf` are the densities of the direction at the vertex by the walk and by BSDF
-/// sampling; `walk` says which technique produced the contribution. Light sampling only keeps the
-/// walk's contributions (and BSDF sampling's where the walk cannot produce the path); BSDF
-/// sampling only never runs the walk.
-#[inline]
-fn manifold_weight(strategy: Strategy, p_walk: f32, p_bsdf: f32, walk: bool) -> f32 {
-    match (strategy, walk) {
-        (Strategy::Mis, true) => power_heuristic(p_walk, p_bsdf),
-        (Strategy::Mis, false) => power_heuristic(p_bsdf, p_walk),
-        (Strategy::LightOnly, true) => 1.0,
-        (Strategy::LightOnly, false) => {
-            if p_walk > 0.0 {
-                0.0
-            } else {
-                1.0
-            }
-        }
-        (Strategy::BsdfOnly, _) => 1.0,
-    }
-}
-
-/// MIS weight of emission reached by the path's current ray (weight 1 for a camera ray, after a
-/// specular event, which light sampling cannot reproduce, and after a vertex where no light was
-/// sampled — a medium point or a reflecting surface inside the stone). `light_pdf` gives the
-/// light and its solid-angle density for the direction.
-#[inline]
-fn emission_weight<S: Spectral>(
-    world: &World,
-    strategy: Strategy,
-    path: &PathState<S>,
-    light_pdf: impl FnOnce() -> (LightRef, f32),
-) -> f32 {
-    let Some(prev) = path.prev else {
-        return 1.0;
-    };
-    if prev.flags.is_specular() || !prev.nee {
-        return 1.0;
-    }
-    match strategy {
-        Strategy::BsdfOnly => 1.0,
-        Strategy::LightOnly => 0.0,
-        Strategy::Mis => {
-            let (light, pdf) = light_pdf();
-            let p_light = world.light_probability(light) * pdf;
-            power_heuristic(prev.pdf, p_light)
-        }
     }
 }

@@ -11,6 +11,7 @@
 //! sample count is kept (the `samples` AOV), so a partial image is still an unbiased mean.
 
 pub mod camera;
+pub mod direct;
 pub mod film;
 pub mod filter;
 pub mod integrator;
@@ -24,9 +25,10 @@ pub mod study;
 pub mod world;
 
 pub use camera::CameraRays;
+pub use direct::Strategy;
 pub use film::{Film, PixelSums};
 pub use filter::FilterSampler;
-pub use integrator::{Strategy, trace};
+pub use integrator::trace;
 pub use output::{Metadata, exr_image};
 pub use path::{PathSample, PathState};
 pub use shading::{ShadingContext, SurfaceBsdf};

@@ -40,9 +40,9 @@ pub struct PrevVertex {
     pub nee: bool,
 }
 
-/// A vertex inside the stone where manifold next-event estimation ran, and the BSDF-sampled
-/// continuation from it: if the path then refracts out through the boundary and meets a light,
-/// that light is weighted against the walk's ([`super::manifold`]).
+/// A vertex where manifold next-event estimation ran, and the BSDF-sampled continuation from it:
+/// if the path then crosses the boundary as the walk's chain does and meets a light, that light
+/// is weighted against the walk's ([`super::manifold`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ManifoldVertex {
     /// The vertex: the origin of the ray that left it.
@@ -50,10 +50,13 @@ pub struct ManifoldVertex {
     /// The sampled direction (unit, world space).
     pub d: Vec3,
     /// Density of the continuation: the direction's per steradian, times the boundary's
-    /// probability of refracting once crossed.
+    /// probability of refracting at each crossing so far.
     pub pdf: f32,
-    /// Whether the path has since refracted out through the boundary, and done nothing else.
-    pub crossed: bool,
+    /// The chain the walk at the vertex solved for.
+    pub chain: crate::render::manifold::Chain,
+    /// Specular transmissions through the boundary since the vertex (and nothing else); the
+    /// path is the walk's when they number the chain's [`crossings`](crate::render::manifold::Chain::crossings).
+    pub crossings: u8,
 }
 
 /// Everything a path knows between two vertices, generic over the transported light `S`.

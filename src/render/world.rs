@@ -326,9 +326,13 @@ impl World {
             .collect();
 
         let manifold = match body {
-            Some(b) if shows_body && b.alpha == 0.0 && scene.effects.on(Effect::ManifoldNee) => {
-                super::manifold::ManifoldSetup::new(b.ior, scene.surface.body_index(), &areas)
-            }
+            Some(b) if shows_body && b.alpha == 0.0 => super::manifold::ManifoldSetup::new(
+                b.ior,
+                scene.surface.body_index(),
+                &areas,
+                scene.effects.on(Effect::ManifoldNee),
+                scene.effects.on(Effect::ManifoldCaustics),
+            ),
             _ => None,
         };
         let platelets = match body {

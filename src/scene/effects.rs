@@ -35,11 +35,14 @@ pub enum Effect {
     /// Manifold next-event estimation: light sampled through a smooth boundary from platelets and
     /// medium points inside the stone (Hanika et al. 2015).
     ManifoldNee,
+    /// Manifold next-event estimation from the floor through the stone (two refractions): the
+    /// caustic a small light throws through a smooth body (Hanika et al. 2015).
+    ManifoldCaustics,
 }
 
 impl Effect {
     /// Every effect, in a fixed order.
-    pub const ALL: [Effect; 13] = [
+    pub const ALL: [Effect; 14] = [
         Effect::Absorption,
         Effect::TTerm,
         Effect::FacetBump,
@@ -49,6 +52,7 @@ impl Effect {
         Effect::Medium,
         Effect::Platelets,
         Effect::ManifoldNee,
+        Effect::ManifoldCaustics,
         Effect::Spectral,
         Effect::Fluorescence,
         Effect::DepthOfField,
@@ -67,6 +71,7 @@ impl Effect {
             Effect::Medium => "medium",
             Effect::Platelets => "platelets",
             Effect::ManifoldNee => "manifold-nee",
+            Effect::ManifoldCaustics => "manifold-caustics",
             Effect::Spectral => "spectral",
             Effect::Fluorescence => "fluorescence",
             Effect::DepthOfField => "depth-of-field",
@@ -97,6 +102,9 @@ impl Effect {
             Effect::Platelets => "a `body` with `platelets`",
             Effect::ManifoldNee => {
                 "a smooth `body` boundary around platelets or a scattering medium, under an area light"
+            }
+            Effect::ManifoldCaustics => {
+                "a smooth `body` boundary on a stage with a floor, under an area light"
             }
             Effect::Spectral => "spectral colours",
             Effect::Fluorescence => "a fluorescent material",

@@ -2,7 +2,7 @@
 //! density of the direction (module docs in [`super`]).
 
 use super::ManifoldSetup;
-use super::walk::{boundary, jacobian, solve};
+use super::walk::{Chain, last, solve};
 use crate::bsdf::fresnel;
 use crate::geometry::{Ray, offset_origin};
 use crate::platelet::PlateletId;
@@ -10,74 +10,108 @@ use crate::render::world::World;
 use crate::spectrum::Spectral;
 use glam::{Vec2, Vec3};
 
-/// Light reaching a vertex inside the stone through the boundary from one sampled light point.
+/// Light reaching a vertex through the boundary from one sampled light point.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ManifoldLight<S> {
     /// Unit direction at the vertex toward the boundary point (world space).
     pub d: Vec3,
     /// The radiance arriving along `d` divided by [`pdf`](Self::pdf): transmittance of the
-    /// interior, `(1 − F) η²` of the boundary, the light's radiance.
+    /// interior, the boundary's `1 − F` at each crossing (and `η²` where the path ends inside),
+    /// the light's radiance.
     pub value: S,
     /// Density of `d` per steradian with which the walk produced it:
-    /// `p_pick / (A · |dω0/dA2|)`.
+    /// `q · p_pick / (A · |dω0/dA2|)`.
     pub pdf: f32,
-    /// The boundary's transmittance `1 − F`: the probability with which BSDF sampling continues
-    /// the path through the boundary (for the MIS weight).
+    /// The product of the boundary's transmittances `1 − F` over the crossings: the probability
+    /// with which BSDF sampling continues the path through them (for the MIS weight).
     pub cross: f32,
 }
 
-/// Manifold next-event estimation from the vertex `x0` inside the stone: picks an area light,
-/// a point on it, walks to the refracted connection and returns the light it brings, unoccluded
-/// (no platelet between `x0` and the boundary, nothing outside between the boundary and the
-/// light), or `None`.
+/// Where a walk starts.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WalkVertex {
+    /// The vertex: inside the body kept off the boundary; outside, the surface point.
+    pub p: Vec3,
+    /// [`Chain::Out`] from inside the body, [`Chain::Through`] from a surface outside it.
+    pub chain: Chain,
+    /// The platelet `p` lies on (it cannot occlude its own light).
+    pub skip: Option<PlateletId>,
+    /// Outside: the surface's unit geometric normal at `p` (the occlusion ray to the entry point
+    /// leaves from `p` moved along it); unused inside.
+    pub ng: Vec3,
+}
+
+/// The random numbers of one walk.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WalkNumbers {
+    /// Picks the light.
+    pub light: f32,
+    /// The point on it.
+    pub point: Vec2,
+    /// The map's switch numbers at the exit and entry points (a stochastic blend may show an
+    /// opaque cell there, which blocks the light).
+    pub map: [f32; 2],
+    /// Decides whether the walk runs ([`walk_probability`]).
+    pub walk: f32,
+}
+
+/// Manifold next-event estimation from `v`: picks an area light, a point on it, walks to the
+/// refracted connection and returns the light it brings, unoccluded (no platelet on the segment
+/// inside, nothing outside between the vertex and the entry or between the exit and the light),
+/// or `None`.
 ///
 /// # Arguments
-/// * `skip` – the platelet `x0` lies on (it cannot occlude its own light).
-/// * `u_light` – picks the light; `u_point` – the point on it.
-/// * `u_map` – the map's switch number at the boundary point (a stochastic blend may show an
-///   opaque cell there, which blocks the light).
 /// * `lambda` – the path's wavelengths.
-#[allow(clippy::too_many_arguments)]
 pub fn sample_light<S: Spectral>(
     world: &World,
     setup: &ManifoldSetup,
-    x0: Vec3,
-    skip: Option<PlateletId>,
-    u_light: f32,
-    u_point: Vec2,
-    u_map: f32,
-    u_walk: f32,
+    v: &WalkVertex,
+    u: &WalkNumbers,
     lambda: &S::Wavelengths,
 ) -> Option<ManifoldLight<S>> {
-    let (index, p_pick) = setup.pick(u_light)?;
+    let (index, p_pick) = setup.pick(u.light)?;
     let light = &world.areas[index];
-    let x2 = light.sample_point(u_point);
-    let q = walk_probability(world, x0, x2);
-    if !(u_walk < q) {
+    let x2 = light.sample_point(u.point);
+    let q = walk_probability(world, v.p, x2, v.chain);
+    if !(u.walk < q) {
         return None;
     }
-    let c = solve(world, x0, x2, light.normal(), setup.eta)?;
+    let c = solve(world, v.p, x2, light.normal(), setup.eta, v.chain)?;
     let x1 = c.exit.p;
-    let u = (x2 - x1) / c.dist;
-    let le = light.emitted(-u);
+    let u_out = (x2 - x1) / c.dist;
+    let le = light.emitted(-u_out);
     if le.is_black() {
         return None;
     }
-    // The map must show the bare boundary there (no opaque cell, no facet).
-    let look = world.map.lookup(c.exit.p_object, u_map);
-    if look.material != setup.boundary || (world.facet_bump && look.facet.is_some()) {
+    // The map must show the bare boundary where the path crosses it (no opaque cell, no facet).
+    let bare = |p_object: Vec3, u_map: f32| {
+        let look = world.map.lookup(p_object, u_map);
+        look.material == setup.boundary && !(world.facet_bump && look.facet.is_some())
+    };
+    if !bare(c.exit.p_object, u.map[0]) {
         return None;
     }
+    // The segment inside the body: from the vertex, or from the entry point.
+    let (start, dir) = match c.exit.entry {
+        None => (v.p, c.d),
+        Some(e) => {
+            if !bare(e.p_object, u.map[1]) {
+                return None;
+            }
+            if blocked(world, offset_origin(v.p, v.ng, c.d), e.p) {
+                return None;
+            }
+            (e.origin, e.inside)
+        }
+    };
     if !world.platelets.is_empty()
         && world
-            .platelet_hit(&Ray::new(x0, c.d), c.exit.t, skip)
+            .platelet_hit(&Ray::new(start, dir), c.exit.t, v.skip)
             .is_some()
     {
         return None;
     }
-    let origin = offset_origin(x1, c.exit.ng, u);
-    let t_max = (c.dist - (origin - x1).length()) * (1.0 - 1e-4);
-    if world.occluded(&Ray::new(origin, u), t_max) {
+    if blocked(world, offset_origin(x1, c.exit.ng, u_out), x2) {
         return None;
     }
     let mut tr = if world.medium {
@@ -86,11 +120,19 @@ pub fn sample_light<S: Spectral>(
         S::ONE
     };
     if let Some(flakes) = &world.flakes {
-        tr *= (-flakes.optical_depth(x0, c.d, c.exit.t)).exp();
+        tr *= (-flakes.optical_depth(start, dir, c.exit.t)).exp();
     }
-    let cross = transmittance(c.exit.cos_inside, setup.eta);
+    let out = transmittance(c.exit.cos_inside, setup.eta);
+    // Radiance entering the body is scaled by η², leaving it by 1/η² (pbrt-v4 §9.5.2).
+    let (cross, scale) = match c.exit.entry {
+        None => (out, setup.eta * setup.eta),
+        Some(e) => (
+            out * (1.0 - fresnel::dielectric(e.cos_outside, setup.eta)),
+            1.0,
+        ),
+    };
     let pdf = q * p_pick / (light.area() * c.jacobian);
-    let value = tr * S::from_unbounded(le, lambda) * (cross * setup.eta * setup.eta / pdf);
+    let value = tr * S::from_unbounded(le, lambda) * (cross * scale / pdf);
     (pdf.is_finite() && pdf > 0.0 && value.is_valid()).then_some(ManifoldLight {
         d: c.d,
         value,
@@ -99,9 +141,26 @@ pub fn sample_light<S: Spectral>(
     })
 }
 
+/// Whether anything blocks the segment from `origin` to just short of `target` (1e-3 of its
+/// length), aimed at `target`: the surface `target` lies on must not count. The ray is aimed at
+/// the target, not cast along the walk's direction: the origin is offset along a normal, and
+/// over the 0.002 film of air under a gem a ray along the walk's direction from the offset
+/// origin met the base 2.5e-5 early, inside any margin short of the target, so the base
+/// occluded its own entry point (tests/platelets/caustics.rs,
+/// `walk_through_a_cabochon_on_a_film_of_air`).
+#[inline]
+fn blocked(world: &World, origin: Vec3, target: Vec3) -> bool {
+    let to = target - origin;
+    let dist = to.length();
+    dist > 0.0 && world.occluded(&Ray::new(origin, to / dist), dist * (1.0 - 1e-3))
+}
+
 /// The density per steradian with which [`sample_light`] would produce the direction `d` at
-/// `x0` that reaches point `x2` on area light `index` through the boundary (for the MIS weight of
-/// the same path found by BSDF sampling); 0 if the walk's measure cannot be computed there.
+/// `x0` that reaches point `x2` on area light `index` through `chain` (for the MIS weight of the
+/// same path found by BSDF sampling). The walk is run from `x0` to `x2`: a walk is a
+/// deterministic function of the light point, so where it converges to another connection (a
+/// chain through a lens can have several) or to none, it never produces this path and the
+/// density is 0 — which keeps the weights of the two techniques summing to one.
 pub fn density(
     world: &World,
     setup: &ManifoldSetup,
@@ -109,38 +168,45 @@ pub fn density(
     d: Vec3,
     x2: Vec3,
     index: usize,
+    chain: Chain,
 ) -> f32 {
     let light = &world.areas[index];
     let p_pick = setup.probability(index);
     if !(p_pick > 0.0) {
         return 0.0;
     }
-    match jacobian(world, x0, d, x2, light.normal(), setup.eta) {
-        Some(j) => {
-            let p = walk_probability(world, x0, x2) * p_pick / (light.area() * j);
+    match solve(world, x0, x2, light.normal(), setup.eta, chain) {
+        Some(c) if c.d.dot(d) > 1.0 - SAME_DIRECTION => {
+            let p = walk_probability(world, x0, x2, chain) * p_pick / (light.area() * c.jacobian);
             if p.is_finite() { p } else { 0.0 }
         }
-        None => 0.0,
+        _ => 0.0,
     }
 }
+
+/// `1 − cos` of the largest angle (≈ 4.5 mrad) between the walk's solution and a BSDF-sampled
+/// direction that counts as the same connection (the walk converges to 1e-5; distinct solutions
+/// of one chain lie much further apart).
+const SAME_DIRECTION: f32 = 1e-5;
 
 /// Transmittance below which the walk is run only sometimes ([`walk_probability`]).
 pub const WALK_THRESHOLD: f32 = 0.05;
 
 /// The probability with which the walk runs from `x0` toward the light point `x2`: 1 unless the
 /// interior in front of it is thick — `min(1, T/`[`WALK_THRESHOLD`]`)`, with `T` the largest
-/// per-channel transmittance (medium and statistical platelets) over the straight line to the
-/// boundary. A walk costs tens of ray casts and deep in a dense medium brings next to nothing
+/// per-channel transmittance (medium and statistical platelets) over the straight line's
+/// segment inside the body. A walk costs tens of ray casts and deep in a dense medium brings next to nothing
 /// (the milky stone scatters every 0.05 units); running it with probability `q` and dividing by
 /// `q` keeps the estimate unbiased, and `q` enters its density for the MIS weight.
-pub fn walk_probability(world: &World, x0: Vec3, x2: Vec3) -> f32 {
+pub fn walk_probability(world: &World, x0: Vec3, x2: Vec3, chain: Chain) -> f32 {
     if !world.medium && world.flakes.is_none() {
         return 1.0;
     }
     let Some(d) = (x2 - x0).try_normalize() else {
         return 1.0;
     };
-    let Some((h, _)) = boundary(world, x0, d) else {
+    // The straight line's segment inside the body (η = 1: no bending).
+    let Some((h, _, _)) = last(world, x0, d, 1.0, chain) else {
         return 1.0;
     };
     let mut tau = if world.medium {

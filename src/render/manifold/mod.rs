@@ -1,5 +1,11 @@
-//! Manifold next-event estimation through one refracting interface (Hanika, Droske & Fascione,
-//! "Manifold Next Event Estimation", Computer Graphics Forum 34(4), EGSR 2015), issue 18.
+//! Manifold next-event estimation through a smooth boundary (Hanika, Droske & Fascione,
+//! "Manifold Next Event Estimation", Computer Graphics Forum 34(4), EGSR 2015), issue 18, for two
+//! chains ([`Chain`]): from a vertex inside the body, one refraction out (`manifold-nee`); from the
+//! floor, a refraction into the body and one out of it — the caustic a small light throws
+//! through the stone, which is also what a viewer sees of the floor through it
+//! (`manifold-caustics`). The text below describes the first; the second is the same walk with
+//! the entry refraction traced (Snell's law at the entry holds by construction, the constraint
+//! sits at the exit), both crossings' `1 − F`, and no `η²` (the radiance enters and leaves).
 //!
 //! A platelet or a medium point inside a smooth-bodied stone cannot see a light: every path to a
 //! light leaves through the boundary, which refracts it. Ordinary next-event estimation has no
@@ -38,12 +44,17 @@
 //! a glass sphere its integral over a light equals the solid angle of the refracted rays that
 //! reach it (tested by shooting).
 //!
-//! **Combination with BSDF sampling.** A path that BSDF sampling finds — vertex, one specular
-//! refraction out through the boundary, light — is the same path the walk would have found; the
-//! two are weighted by the power heuristic over the densities of the direction at `x0`: the
-//! walk's `p_pick · p_A / |dω0/dA2|` and BSDF sampling's `p_bsdf(d) · (1 − F)` (the smooth
-//! boundary picks transmission with probability `1 − F`). The BSDF side recomputes `|dω0/dA2|` at
-//! the path it found ([`density`]).
+//! **Combination with BSDF sampling.** A path that BSDF sampling finds — vertex, the chain's
+//! specular refractions through the boundary, light — may be the path the walk would have found;
+//! the two are weighted by the power heuristic over the densities of the direction at `x0`: the
+//! walk's `p_pick · p_A / |dω0/dA2|` and BSDF sampling's `p_bsdf(d) · Π (1 − F)` (the smooth
+//! boundary picks transmission with probability `1 − F`). The BSDF side runs the walk to the
+//! light point it reached ([`density`]): the walk is a deterministic function of the light point,
+//! so where it converges to another connection (a lens has several for one light point: from the
+//! floor under a glass sphere the walk returns about a third of the directions that reach the
+//! light, tests/platelets/caustics.rs) the walk's density of this path is 0 and BSDF sampling
+//! keeps it whole. The seed is the straight line, so a light point whose straight line misses
+//! the body gets no walk from the floor (BSDF sampling alone finds those paths).
 //!
 //! Files: [`walk`] solves for the connection and its measure; [`light`] turns a connection into a
 //! light sample and gives the density the MIS weight needs.
@@ -52,10 +63,12 @@ pub mod light;
 pub mod walk;
 
 pub use light::{
-    ManifoldLight, WALK_THRESHOLD, density, sample_light, transmittance, walk_probability,
+    ManifoldLight, WALK_THRESHOLD, WalkNumbers, WalkVertex, density, sample_light, transmittance,
+    walk_probability,
 };
 pub use walk::{
-    Connection, Exit, MAX_ITERATIONS, MAX_STEP, STAGES, TOLERANCE, exit, jacobian, solve,
+    Chain, Connection, Entry, Exit, MAX_ITERATIONS, MAX_STEP, STAGES, TOLERANCE, exit, jacobian,
+    solve,
 };
 
 use crate::light::Area;
@@ -69,12 +82,26 @@ pub struct ManifoldSetup {
     pub boundary: u32,
     /// Area lights the walk connects to: index and selection probability (∝ power).
     pub lights: Vec<(usize, f32)>,
+    /// Walks from platelets and medium points inside ([`Chain::Out`], effect `manifold-nee`).
+    pub inside: bool,
+    /// Walks from the floor through the stone ([`Chain::Through`], effect `manifold-caustics`).
+    pub through: bool,
 }
 
 impl ManifoldSetup {
     /// The setup for a smooth boundary of relative IOR `eta` (material `boundary`) and the area
-    /// lights of the scene; `None` when no light emits.
-    pub fn new(eta: f32, boundary: u32, areas: &[Area]) -> Option<ManifoldSetup> {
+    /// lights of the scene, walking from `inside` and/or `through` the stone; `None` when no
+    /// light emits or neither kind of walk is wanted.
+    pub fn new(
+        eta: f32,
+        boundary: u32,
+        areas: &[Area],
+        inside: bool,
+        through: bool,
+    ) -> Option<ManifoldSetup> {
+        if !inside && !through {
+            return None;
+        }
         let power: Vec<f32> = areas
             .iter()
             .map(|a| a.power())
@@ -90,6 +117,8 @@ impl ManifoldSetup {
                 .filter(|(_, p)| **p > 0.0)
                 .map(|(i, p)| (i, p / total))
                 .collect(),
+            inside,
+            through,
         })
     }
 

@@ -2,7 +2,7 @@
 //! connection it finds (module docs in [`super`]).
 
 use crate::bsdf::refract;
-use crate::geometry::{Frame, Ray, StoneHit};
+use crate::geometry::{Frame, Ray, StoneHit, offset_origin};
 use crate::render::world::World;
 use glam::{Vec2, Vec3};
 
@@ -18,6 +18,43 @@ const FD_STEP: f32 = 1e-3;
 /// Most halvings of one Newton step while the residual grows.
 const MAX_HALVINGS: u32 = 6;
 
+/// The chain of specular events between the vertex and the light that the walk solves for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Chain {
+    /// From a vertex inside the body (a platelet, a medium point): one refraction out.
+    Out,
+    /// From a surface outside the body (the floor): a refraction into the body, then one out —
+    /// the light a small lamp focuses through the stone (a caustic).
+    Through,
+}
+
+impl Chain {
+    /// How many times the chain crosses the boundary (each a specular transmission).
+    pub fn crossings(self) -> u8 {
+        match self {
+            Chain::Out => 1,
+            Chain::Through => 2,
+        }
+    }
+}
+
+/// Where a [`Chain::Through`] path enters the body.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Entry {
+    /// The boundary point, world space.
+    pub p: Vec3,
+    /// Object-space point (for the surface map).
+    pub p_object: Vec3,
+    /// Distance from the vertex, world units.
+    pub t: f32,
+    /// Cosine between the direction outside and the shading normal (> 0).
+    pub cos_outside: f32,
+    /// The refracted direction inside (unit).
+    pub inside: Vec3,
+    /// Origin of the segment inside (the point moved off the boundary, inward).
+    pub origin: Vec3,
+}
+
 /// Where a direction from the vertex leaves the stone.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Exit {
@@ -29,12 +66,15 @@ pub struct Exit {
     pub ng: Vec3,
     /// Unit shading normal at `x1`, out of the stone (Snell's law uses it, as the boundary BSDF).
     pub n: Vec3,
-    /// Distance from the vertex to `x1`, world units.
+    /// Length of the segment inside the body that ends at `x1`, world units: from the vertex
+    /// ([`Chain::Out`]) or from the entry point ([`Chain::Through`]).
     pub t: f32,
     /// The refracted direction leaving `x1` outward (unit).
     pub out: Vec3,
     /// Cosine between the direction inside and `n` (> 0).
     pub cos_inside: f32,
+    /// Where the path entered the body ([`Chain::Through`] only).
+    pub entry: Option<Entry>,
 }
 
 /// A refracted connection from a vertex to a point on a light.
@@ -50,15 +90,56 @@ pub struct Connection {
     pub jacobian: f32,
 }
 
-/// The first boundary point along `(x0, d)` and the direction refracted out of it; `None` if the
-/// ray does not leave the stone there (no hit, it enters instead, or total internal reflection).
+/// The refraction into the body along `(x0, d)` from outside; `None` if the ray misses the body
+/// or does not enter it there.
+fn entry(world: &World, x0: Vec3, d: Vec3, eta: f32) -> Option<Entry> {
+    let h = world.stone.intersect(&Ray::new(x0, d), f32::INFINITY)?;
+    let c = -h.ns.dot(d);
+    if !(h.ng.dot(d) < 0.0 && c > 0.0) {
+        return None;
+    }
+    let inside = refract(-d, h.ns, eta)?;
+    if inside.dot(h.ng) >= 0.0 {
+        return None;
+    }
+    Some(Entry {
+        p: h.p,
+        p_object: h.p_object,
+        t: h.t,
+        cos_outside: c,
+        inside,
+        origin: offset_origin(h.p, h.ng, inside),
+    })
+}
+
+/// The chain's last boundary point along `(x0, d)` (where it leaves the body), the direction
+/// arriving there from inside, and the entry point of a [`Chain::Through`].
+#[inline]
+pub(super) fn last(
+    world: &World,
+    x0: Vec3,
+    d: Vec3,
+    eta: f32,
+    chain: Chain,
+) -> Option<(StoneHit, Vec3, Option<Entry>)> {
+    match chain {
+        Chain::Out => boundary(world, x0, d).map(|(h, _)| (h, d, None)),
+        Chain::Through => {
+            let e = entry(world, x0, d, eta)?;
+            boundary(world, e.origin, e.inside).map(|(h, _)| (h, e.inside, Some(e)))
+        }
+    }
+}
+
+/// Where the chain from `x0` along `d` leaves the body and the direction refracted out there;
+/// `None` if it does not (no hit, it enters where it should leave, or total internal reflection).
 ///
 /// # Arguments
 /// * `eta` – IOR inside over outside.
-pub fn exit(world: &World, x0: Vec3, d: Vec3, eta: f32) -> Option<Exit> {
-    let (h, cos_inside) = boundary(world, x0, d)?;
+pub fn exit(world: &World, x0: Vec3, d: Vec3, eta: f32, chain: Chain) -> Option<Exit> {
+    let (h, inside, entry) = last(world, x0, d, eta, chain)?;
     // `refract` takes the direction away from the surface on the incident side.
-    let out = refract(-d, h.ns, eta)?;
+    let out = refract(-inside, h.ns, eta)?;
     Some(Exit {
         p: h.p,
         p_object: h.p_object,
@@ -66,7 +147,8 @@ pub fn exit(world: &World, x0: Vec3, d: Vec3, eta: f32) -> Option<Exit> {
         n: h.ns,
         t: h.t,
         out,
-        cos_inside,
+        cos_inside: h.ns.dot(inside),
+        entry,
     })
 }
 
@@ -79,15 +161,152 @@ pub(super) fn boundary(world: &World, x0: Vec3, d: Vec3) -> Option<(StoneHit, f3
     (h.ng.dot(d) > 0.0 && c > 0.0).then_some((h, c))
 }
 
-/// The constraint at direction `d`: the tangential part (3-D, perpendicular to the shading normal
-/// at `x1(d)`) of the generalised half-vector `η d − u`, with `u` the unit direction from `x1` to
-/// `x2` — zero exactly where Snell's law bends `d` onto `u` — and the boundary hit.
-#[inline]
-fn constraint(world: &World, x0: Vec3, d: Vec3, x2: Vec3, eta: f32) -> Option<(Vec3, StoneHit)> {
-    let (h, _) = boundary(world, x0, d)?;
-    let u = (x2 - h.p).try_normalize()?;
-    let v = eta * d - u;
-    Some((v - h.ns * v.dot(h.ns), h))
+/// One walk's problem: connect the vertex `x0` to the light point `x2` through `chain`, across a
+/// boundary of index `eta` (inside over outside; the continuation varies it).
+#[derive(Clone, Copy)]
+struct Problem<'a> {
+    world: &'a World,
+    x0: Vec3,
+    x2: Vec3,
+    eta: f32,
+    chain: Chain,
+}
+
+impl Problem<'_> {
+    /// The constraint at direction `d`: the tangential part (3-D, perpendicular to the shading
+    /// normal at the chain's exit point `x1(d)`) of the generalised half-vector `η w − u`, with
+    /// `w` the direction arriving at `x1` from inside (`d` itself for [`Chain::Out`]) and `u` the
+    /// unit direction from `x1` to `x2` — zero exactly where Snell's law bends `w` onto `u` — and
+    /// the exit hit. The entry refraction of a [`Chain::Through`] holds by construction (it is
+    /// traced).
+    #[inline]
+    fn constraint(&self, d: Vec3) -> Option<(Vec3, StoneHit)> {
+        let (h, w, _) = last(self.world, self.x0, d, self.eta, self.chain)?;
+        let u = (self.x2 - h.p).try_normalize()?;
+        let v = self.eta * w - u;
+        Some((v - h.ns * v.dot(h.ns), h))
+    }
+
+    /// `∂C/∂a` in the coordinates `basis` at `a` in `frame`: columns for the two tangent
+    /// directions, by forward (`c0` the constraint at `a`) or central differences. `None` if a
+    /// perturbed ray does not leave the stone.
+    fn jacobian_at(
+        &self,
+        frame: &Frame,
+        a: Vec2,
+        basis: (Vec3, Vec3),
+        c0: Option<Vec3>,
+    ) -> Option<[[f32; 2]; 2]> {
+        let mut j = [[0.0; 2]; 2];
+        for (col, dir) in [Vec2::X, Vec2::Y].into_iter().enumerate() {
+            let plus = self.constraint(turn(frame, a + dir * FD_STEP))?.0;
+            let diff = match c0 {
+                Some(c0) => (plus - c0) / FD_STEP,
+                None => {
+                    let minus = self.constraint(turn(frame, a - dir * FD_STEP))?.0;
+                    (plus - minus) / (2.0 * FD_STEP)
+                }
+            };
+            j[0][col] = diff.dot(basis.0);
+            j[1][col] = diff.dot(basis.1);
+        }
+        Some(j)
+    }
+
+    /// Newton's method on the direction at `x0` from `seed` (module docs) with Broyden's
+    /// rank-one updates of the Jacobian (Broyden, "A class of methods for solving nonlinear
+    /// simultaneous equations", Math. Comp. 19, 1965): the finite-difference Jacobian is taken
+    /// once at the seed (two chain traces) and then updated from each step's change of the
+    /// constraint, so an iteration costs one trace; where a step fails to lower the constraint
+    /// even when halved, the Jacobian is taken afresh by differences, once per failure. The
+    /// coordinates stay those of the seed: `d` in the tangent frame of `seed`, the constraint in
+    /// the tangent basis of the seed's exit point. Returns the converged direction, or `None`.
+    fn newton(&self, seed: Vec3, tolerance: f32) -> Option<Vec3> {
+        let frame = Frame::from_normal(seed);
+        let (mut c, h) = self.constraint(seed)?;
+        let b = Frame::from_normal(h.ns);
+        let basis = (b.s, b.t);
+        let coords = |c: Vec3| Vec2::new(c.dot(basis.0), c.dot(basis.1));
+        let mut a = Vec2::ZERO;
+        let mut d = seed;
+        let mut j = self.jacobian_at(&frame, a, basis, Some(c))?;
+        let mut fresh = true;
+        for _ in 0..MAX_ITERATIONS {
+            if c.length() < tolerance {
+                return Some(d);
+            }
+            let dt = det(&j);
+            let r = coords(c);
+            let mut step = if dt.abs() > 1e-12 && dt.is_finite() {
+                -Vec2::new(j[1][1] * r.x - j[0][1] * r.y, j[0][0] * r.y - j[1][0] * r.x) / dt
+            } else {
+                Vec2::ZERO
+            };
+            if step.length() > MAX_STEP {
+                step *= MAX_STEP / step.length();
+            }
+            let mut accepted = None;
+            if step.length() > 0.0 {
+                for _ in 0..=MAX_HALVINGS {
+                    let trial = turn(&frame, a + step);
+                    if let Some((ct, _)) = self.constraint(trial)
+                        && ct.length() < c.length()
+                    {
+                        accepted = Some((trial, ct));
+                        break;
+                    }
+                    step *= 0.5;
+                }
+            }
+            match accepted {
+                Some((trial, ct)) => {
+                    // Broyden: J += (Δr − J Δa) Δaᵀ / |Δa|².
+                    let dr = coords(ct) - r;
+                    let jda = Vec2::new(
+                        j[0][0] * step.x + j[0][1] * step.y,
+                        j[1][0] * step.x + j[1][1] * step.y,
+                    );
+                    let k = (dr - jda) / step.length_squared();
+                    j[0][0] += k.x * step.x;
+                    j[0][1] += k.x * step.y;
+                    j[1][0] += k.y * step.x;
+                    j[1][1] += k.y * step.y;
+                    (a, d, c) = (a + step, trial, ct);
+                    fresh = false;
+                }
+                // A step from a fresh Jacobian that cannot lower the constraint: give up.
+                None if fresh => return None,
+                None => {
+                    j = self.jacobian_at(&frame, a, basis, Some(c))?;
+                    fresh = true;
+                }
+            }
+        }
+        (c.length() < tolerance).then_some(d)
+    }
+
+    /// `|dω0/dA2|` (world units⁻²) at the solution `d` whose exit point is `x1` with shading
+    /// normal `n1` (module docs): `|det ∂C/∂x2| / |det ∂C/∂d|` in the tangent basis at `x1`,
+    /// `∂C/∂x2` in closed form on the light's plane (unit normal `n_light`) and `∂C/∂d` by central
+    /// differences. `None` if a perturbed ray does not leave the stone or the map is singular.
+    fn measure(&self, d: Vec3, n_light: Vec3, x1: Vec3, n1: Vec3) -> Option<f32> {
+        let to_light = self.x2 - x1;
+        let l = to_light.length();
+        let u = to_light / l;
+        let b = Frame::from_normal(n1);
+        let basis = (b.s, b.t);
+        let jd = self.jacobian_at(&Frame::from_normal(d), Vec2::ZERO, basis, None)?;
+        // ∂C/∂x2 = −P_tangent (I − u uᵀ) / L on the light's plane (axes a, b).
+        let light = Frame::from_normal(n_light);
+        let col = |e: Vec3| -(e - u * u.dot(e)) / l;
+        let (ca, cb) = (col(light.s), col(light.t));
+        let jx = [
+            [ca.dot(basis.0), cb.dot(basis.0)],
+            [ca.dot(basis.1), cb.dot(basis.1)],
+        ];
+        let jac = det(&jx).abs() / det(&jd).abs();
+        (jac.is_finite() && jac > 0.0).then_some(jac)
+    }
 }
 
 /// `d` turned by the tangent coordinates `a` (radians, small) in `frame` (whose normal is `d`).
@@ -96,42 +315,17 @@ fn turn(frame: &Frame, a: Vec2) -> Vec3 {
     (frame.n + frame.s * a.x + frame.t * a.y).normalize()
 }
 
-/// `∂C/∂a` in the coordinates `basis`: columns for the two tangent directions of `d`, by forward
-/// (`central: false`, with `c0` the constraint at `d`) or central differences. `None` if a
-/// perturbed ray does not leave the stone.
-#[allow(clippy::too_many_arguments)]
-fn constraint_jacobian(
-    world: &World,
-    x0: Vec3,
-    d: Vec3,
-    x2: Vec3,
-    eta: f32,
-    basis: (Vec3, Vec3),
-    c0: Vec3,
-    central: bool,
-) -> Option<[[f32; 2]; 2]> {
-    let f = Frame::from_normal(d);
-    let mut j = [[0.0; 2]; 2];
-    for (col, dir) in [Vec2::X, Vec2::Y].into_iter().enumerate() {
-        let plus = constraint(world, x0, turn(&f, dir * FD_STEP), x2, eta)?.0;
-        let diff = if central {
-            let minus = constraint(world, x0, turn(&f, -dir * FD_STEP), x2, eta)?.0;
-            (plus - minus) / (2.0 * FD_STEP)
-        } else {
-            (plus - c0) / FD_STEP
-        };
-        j[0][col] = diff.dot(basis.0);
-        j[1][col] = diff.dot(basis.1);
-    }
-    Some(j)
-}
-
 #[inline]
 fn det(j: &[[f32; 2]; 2]) -> f32 {
     j[0][0] * j[1][1] - j[0][1] * j[1][0]
 }
 
-/// Solves for the refracted connection from `x0` (inside the stone) to `x2` (a light point whose
+/// Stages of the continuation in the index.
+pub const STAGES: u32 = 4;
+/// Convergence of an intermediate stage.
+const STAGE_TOLERANCE: f32 = 1e-3;
+
+/// Solves for the refracted connection from `x0` through `chain` to `x2` (a light point whose
 /// emitting plane has unit normal `n_light`); `None` if the walk does not converge.
 ///
 /// Seeded with the straight line `x0 → x2`; if Newton's method fails from there, it follows the
@@ -140,9 +334,23 @@ fn det(j: &[[f32; 2]; 2]) -> f32 {
 ///
 /// # Arguments
 /// * `eta` – the boundary's IOR inside over outside.
-pub fn solve(world: &World, x0: Vec3, x2: Vec3, n_light: Vec3, eta: f32) -> Option<Connection> {
+pub fn solve(
+    world: &World,
+    x0: Vec3,
+    x2: Vec3,
+    n_light: Vec3,
+    eta: f32,
+    chain: Chain,
+) -> Option<Connection> {
     let seed = (x2 - x0).try_normalize()?;
-    let d = match newton(world, x0, x2, eta, seed, TOLERANCE) {
+    let problem = Problem {
+        world,
+        x0,
+        x2,
+        eta,
+        chain,
+    };
+    let d = match problem.newton(seed, TOLERANCE) {
         Some(d) => d,
         None => {
             let mut d = seed;
@@ -153,19 +361,23 @@ pub fn solve(world: &World, x0: Vec3, x2: Vec3, n_light: Vec3, eta: f32) -> Opti
                 } else {
                     STAGE_TOLERANCE
                 };
-                d = newton(world, x0, x2, eta_k, d, tol)?;
+                d = Problem {
+                    eta: eta_k,
+                    ..problem
+                }
+                .newton(d, tol)?;
             }
             d
         }
     };
-    let e = exit(world, x0, d, eta)?;
+    let e = exit(world, x0, d, eta, chain)?;
     let to_light = x2 - e.p;
     let dist = to_light.length();
     // Snell's law holds and the refracted ray really heads for the light.
     if e.out.dot(to_light) < dist * (1.0 - 1e-3) {
         return None;
     }
-    let jacobian = measure(world, x0, d, x2, n_light, eta, e.p, e.n)?;
+    let jacobian = problem.measure(d, n_light, e.p, e.n)?;
     Some(Connection {
         d,
         exit: e,
@@ -174,110 +386,9 @@ pub fn solve(world: &World, x0: Vec3, x2: Vec3, n_light: Vec3, eta: f32) -> Opti
     })
 }
 
-/// Stages of the continuation in the index.
-pub const STAGES: u32 = 4;
-/// Convergence of an intermediate stage.
-const STAGE_TOLERANCE: f32 = 1e-3;
-
-/// Newton's method on the direction at `x0` from `seed` (module docs) with Broyden's rank-one
-/// updates of the Jacobian (Broyden, "A class of methods for solving nonlinear simultaneous
-/// equations", Math. Comp. 19, 1965): the finite-difference Jacobian is taken once at the seed
-/// (two ray casts) and then updated from each step's change of the constraint, so an iteration
-/// costs one cast; where a step fails to lower the constraint even when halved, the Jacobian is
-/// taken afresh by differences, once per failure. The coordinates stay those of the seed: `d` in
-/// the tangent frame of `seed`, the constraint in the tangent basis of the seed's boundary point.
-/// Returns the converged direction, or `None`.
-fn newton(world: &World, x0: Vec3, x2: Vec3, eta: f32, seed: Vec3, tolerance: f32) -> Option<Vec3> {
-    let frame = Frame::from_normal(seed);
-    let (mut c, h) = constraint(world, x0, seed, x2, eta)?;
-    let b = Frame::from_normal(h.ns);
-    let basis = (b.s, b.t);
-    let coords = |c: Vec3| Vec2::new(c.dot(basis.0), c.dot(basis.1));
-    let mut a = Vec2::ZERO;
-    let mut d = seed;
-    let mut j = constraint_jacobian(world, x0, d, x2, eta, basis, c, false)?;
-    let mut fresh = true;
-    for _ in 0..MAX_ITERATIONS {
-        if c.length() < tolerance {
-            return Some(d);
-        }
-        let dt = det(&j);
-        let r = coords(c);
-        let mut step = if dt.abs() > 1e-12 && dt.is_finite() {
-            -Vec2::new(j[1][1] * r.x - j[0][1] * r.y, j[0][0] * r.y - j[1][0] * r.x) / dt
-        } else {
-            Vec2::ZERO
-        };
-        if step.length() > MAX_STEP {
-            step *= MAX_STEP / step.length();
-        }
-        let mut accepted = None;
-        if step.length() > 0.0 {
-            for _ in 0..=MAX_HALVINGS {
-                let trial = turn(&frame, a + step);
-                if let Some((ct, _)) = constraint(world, x0, trial, x2, eta)
-                    && ct.length() < c.length()
-                {
-                    accepted = Some((trial, ct));
-                    break;
-                }
-                step *= 0.5;
-            }
-        }
-        match accepted {
-            Some((trial, ct)) => {
-                // Broyden: J += (Δr − J Δa) Δaᵀ / |Δa|².
-                let dr = coords(ct) - r;
-                let jda = Vec2::new(
-                    j[0][0] * step.x + j[0][1] * step.y,
-                    j[1][0] * step.x + j[1][1] * step.y,
-                );
-                let k = (dr - jda) / step.length_squared();
-                j[0][0] += k.x * step.x;
-                j[0][1] += k.x * step.y;
-                j[1][0] += k.y * step.x;
-                j[1][1] += k.y * step.y;
-                (a, d, c) = (a + step, trial, ct);
-                fresh = false;
-            }
-            // A step from a fresh Jacobian that cannot lower the constraint: give up.
-            None if fresh => return None,
-            None => {
-                j = finite_difference_at(world, x0, &frame, a, x2, eta, basis, c)?;
-                fresh = true;
-            }
-        }
-    }
-    (c.length() < tolerance).then_some(d)
-}
-
-/// The forward-difference Jacobian of the constraint in the seed's coordinates at `a` (the
-/// constraint there is `c`).
-#[allow(clippy::too_many_arguments)]
-fn finite_difference_at(
-    world: &World,
-    x0: Vec3,
-    frame: &Frame,
-    a: Vec2,
-    x2: Vec3,
-    eta: f32,
-    basis: (Vec3, Vec3),
-    c: Vec3,
-) -> Option<[[f32; 2]; 2]> {
-    let mut j = [[0.0; 2]; 2];
-    for (col, dir) in [Vec2::X, Vec2::Y].into_iter().enumerate() {
-        let plus = constraint(world, x0, turn(frame, a + dir * FD_STEP), x2, eta)?.0;
-        let diff = (plus - c) / FD_STEP;
-        j[0][col] = diff.dot(basis.0);
-        j[1][col] = diff.dot(basis.1);
-    }
-    Some(j)
-}
-
-/// `|dω0/dA2|` (world units⁻²) of the refracted path from `x0` along `d` to the light point `x2`
-/// (module docs): `|det ∂C/∂x2| / |det ∂C/∂d|` in the tangent basis at `x1`, `∂C/∂x2` in closed
-/// form on the light's plane and `∂C/∂d` by central differences. `None` if a perturbed ray does
-/// not leave the stone or the map is singular.
+/// `|dω0/dA2|` (world units⁻²) of the path from `x0` along `d` through `chain` to the light point
+/// `x2` on a light of unit normal `n_light` (module docs); `None` if a perturbed ray does not
+/// follow the chain or the map is singular.
 pub fn jacobian(
     world: &World,
     x0: Vec3,
@@ -285,39 +396,17 @@ pub fn jacobian(
     x2: Vec3,
     n_light: Vec3,
     eta: f32,
+    chain: Chain,
 ) -> Option<f32> {
-    let (h, _) = boundary(world, x0, d)?;
-    measure(world, x0, d, x2, n_light, eta, h.p, h.ns)
-}
-
-/// [`jacobian`] where the boundary point `x1` and its shading normal `n1` along `d` are known.
-#[allow(clippy::too_many_arguments)]
-fn measure(
-    world: &World,
-    x0: Vec3,
-    d: Vec3,
-    x2: Vec3,
-    n_light: Vec3,
-    eta: f32,
-    x1: Vec3,
-    n1: Vec3,
-) -> Option<f32> {
-    let to_light = x2 - x1;
-    let l = to_light.length();
-    let u = to_light / l;
-    let b = Frame::from_normal(n1);
-    let basis = (b.s, b.t);
-    let jd = constraint_jacobian(world, x0, d, x2, eta, basis, Vec3::ZERO, true)?;
-    // ∂C/∂x2 = −P_tangent (I − u uᵀ) / L on the light's plane (axes a, b).
-    let light = Frame::from_normal(n_light);
-    let col = |e: Vec3| -(e - u * u.dot(e)) / l;
-    let (ca, cb) = (col(light.s), col(light.t));
-    let jx = [
-        [ca.dot(basis.0), cb.dot(basis.0)],
-        [ca.dot(basis.1), cb.dot(basis.1)],
-    ];
-    let jac = det(&jx).abs() / det(&jd).abs();
-    (jac.is_finite() && jac > 0.0).then_some(jac)
+    let (h, _, _) = last(world, x0, d, eta, chain)?;
+    let problem = Problem {
+        world,
+        x0,
+        x2,
+        eta,
+        chain,
+    };
+    problem.measure(d, n_light, h.p, h.ns)
 }
 
 #[cfg(test)]

@@ -1,0 +1,129 @@
+//! Light sampling at a vertex and the multiple-importance weights of the techniques that reach a
+//! light (Veach & Guibas, "Optimally Combining Sampling Techniques for Monte Carlo Rendering",
+//! SIGGRAPH 1995: power heuristic, β = 2): next-event estimation against BSDF sampling, and the
+//! manifold walks against BSDF sampling of the same chains ([`super::manifold`]).
+
+use super::path::{PathSample, PathState};
+use super::shading::SurfaceBsdf;
+use super::world::{LightRef, World};
+use crate::bsdf::{Bsdf, Bxdf, power_heuristic};
+use crate::geometry::{Ray, offset_origin};
+use crate::spectrum::Spectral;
+use glam::Vec3;
+
+/// Which estimators of direct light are used.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Strategy {
+    /// Light sampling and BSDF sampling, combined by the power heuristic.
+    #[default]
+    Mis,
+    /// Light sampling only: light reached by a BSDF-sampled ray is ignored (except from the
+    /// camera).
+    LightOnly,
+    /// BSDF sampling only: no shadow rays.
+    BsdfOnly,
+}
+
+/// Next-event estimation at `sb`: one light sample, weighted against BSDF sampling by `strategy`.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub(super) fn direct_light<S: Spectral>(
+    world: &World,
+    strategy: Strategy,
+    sb: &SurfaceBsdf,
+    wo_local: Vec3,
+    u_light: f32,
+    u_point: glam::Vec2,
+    path: &mut PathState<S>,
+    out: &mut PathSample,
+) where
+    Bsdf: Bxdf<S>,
+{
+    let Some((light, p_pick)) = world.pick_light(u_light) else {
+        return;
+    };
+    let sample = match light {
+        LightRef::Area(i) => world.areas[i].sample(sb.p, u_point),
+        LightRef::Environment => world.environment.sample(u_point),
+    };
+    let Some(ls) = sample else {
+        return;
+    };
+    if !sb.admits(ls.wi) || (world.transmission_off && ls.wi.dot(sb.ng) < 0.0) {
+        return;
+    }
+    let (wi_local, f) = sb.eval::<S>(wo_local, ls.wi);
+    if f.is_black() {
+        return;
+    }
+    let origin = offset_origin(sb.p, sb.ng, ls.wi);
+    let t_max = if ls.dist.is_finite() {
+        (ls.dist - (origin - sb.p).length()) * (1.0 - 1e-4)
+    } else {
+        f32::INFINITY
+    };
+    out.rays += 1;
+    if world.occluded(&Ray::new(origin, ls.wi), t_max) {
+        return;
+    }
+    let p_light = p_pick * ls.pdf;
+    let w = match strategy {
+        Strategy::Mis => power_heuristic(p_light, sb.pdf::<S>(wo_local, wi_local)),
+        _ => 1.0,
+    };
+    let radiance = S::from_unbounded(ls.radiance, &path.lambda);
+    let c = path.throughput() * f * radiance * (wi_local.z.abs() * w / p_light);
+    if c.is_valid() {
+        path.l += c;
+    }
+}
+
+/// Weight of one of the two ways to a light through the boundary (module [`manifold`]):
+/// `p_walk` and `p_bsdf` are the densities of the direction at the vertex by the walk and by BSDF
+/// sampling; `walk` says which technique produced the contribution. Light sampling only keeps the
+/// walk's contributions (and BSDF sampling's where the walk cannot produce the path); BSDF
+/// sampling only never runs the walk.
+#[inline]
+pub(super) fn manifold_weight(strategy: Strategy, p_walk: f32, p_bsdf: f32, walk: bool) -> f32 {
+    match (strategy, walk) {
+        (Strategy::Mis, true) => power_heuristic(p_walk, p_bsdf),
+        (Strategy::Mis, false) => power_heuristic(p_bsdf, p_walk),
+        (Strategy::LightOnly, true) => 1.0,
+        (Strategy::LightOnly, false) => {
+            if p_walk > 0.0 {
+                0.0
+            } else {
+                1.0
+            }
+        }
+        (Strategy::BsdfOnly, _) => 1.0,
+    }
+}
+
+/// MIS weight of emission reached by the path's current ray (weight 1 for a camera ray, after a
+/// specular event, which light sampling cannot reproduce, and after a vertex where no light was
+/// sampled — a medium point or a reflecting surface inside the stone). `light_pdf` gives the
+/// light and its solid-angle density for the direction.
+#[inline]
+pub(super) fn emission_weight<S: Spectral>(
+    world: &World,
+    strategy: Strategy,
+    path: &PathState<S>,
+    light_pdf: impl FnOnce() -> (LightRef, f32),
+) -> f32 {
+    let Some(prev) = path.prev else {
+        return 1.0;
+    };
+    if prev.flags.is_specular() || !prev.nee {
+        return 1.0;
+    }
+    match strategy {
+        Strategy::BsdfOnly => 1.0,
+        Strategy::LightOnly => 0.0,
+        Strategy::Mis => {
+            let (light, pdf) = light_pdf();
+            let p_light = world.light_probability(light) * pdf;
+            power_heuristic(prev.pdf, p_light)
+        }
+    }
+}
