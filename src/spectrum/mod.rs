@@ -20,6 +20,7 @@
 //! code size for each variant, paid only by the variants the binary instantiates.
 
 pub mod rgb;
+pub mod wavelengths;
 
 pub use rgb::{CHANNELS, RgbSample};
 
