@@ -1,0 +1,154 @@
+//! Effects of the stage — `depth-of-field`, `environment-importance` — and the effects this
+//! version does not simulate (module docs of tests/effects.rs).
+
+use super::*;
+
+/// A coated sphere seen by `camera`.
+fn with_camera(camera: &str) -> Scene {
+    scene(&format!(
+        r#"(materials: {{ "a": (coats: [(ior: 1.5, roughness: 3.0)], base: Lambert(albedo: Gray(0.5))) }},
+            surface: Voronoi(scale: 0.1, entries: [(1.0, Material("a"))]),
+            stage: (camera: {camera}))"#
+    ))
+}
+
+#[test]
+fn depth_of_field_code_changes_nothing_for_a_pinhole_or_orthographic_camera() {
+    let pinhole = with_camera(
+        "Perspective(from: (0.0, 2.6, 4.2), to: (0.0, 0.15, 0.0), fov: 30.0, aperture: 0.0, \
+         focus_distance: 2.0)",
+    );
+    assert_untouched(Effect::DepthOfField, "a pinhole camera", &pinhole);
+    let ortho =
+        with_camera("Orthographic(from: (0.0, 3.0, 4.0), to: (0.0, 0.2, 0.0), height: 2.6)");
+    assert_untouched(Effect::DepthOfField, "an orthographic camera", &ortho);
+}
+
+#[test]
+fn depth_of_field_forced_off_gives_a_pinhole() {
+    let lens = with_camera(
+        "Perspective(from: (0.0, 2.6, 4.2), to: (0.0, 0.15, 0.0), fov: 30.0, aperture: 0.2, \
+         focus_distance: 2.0)",
+    );
+    assert_live(Effect::DepthOfField, "a thin lens", &lens);
+}
+
+/// The bare scene under `environment` with no lights (the sky is the only light).
+fn under_sky(environment: &str) -> Scene {
+    scene(&format!(
+        r#"(materials: {{ "g": (coats: [(ior: 1.5, roughness: 10.0)], base: Lambert(albedo: Gray(0.5))) }},
+            surface: Material("g"),
+            stage: (lights: [], environment: {environment}))"#
+    ))
+}
+
+#[test]
+fn environment_importance_code_changes_nothing_for_analytic_skies() {
+    for sky in [
+        "Constant(Gray(0.8))",
+        "Gradient(zenith: Rgb(0.2, 0.4, 1.0), horizon: Gray(1.0), nadir: Rgb(0.5, 0.3, 0.1))",
+    ] {
+        assert_untouched(Effect::EnvironmentImportance, sky, &under_sky(sky));
+    }
+}
+
+#[test]
+fn environment_importance_forced_off_samples_the_map_uniformly() {
+    // A 32 × 16 lat-long sky, dim blue with a bright warm patch.
+    let dir = std::env::temp_dir().join(format!("lapidary-effects-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("sky.exr");
+    let (w, h) = (32u32, 16u32);
+    let mut chans = vec![vec![0.0f32; (w * h) as usize]; 3];
+    for y in 0..h {
+        for x in 0..w {
+            let sun = (8..14).contains(&x) && (3..7).contains(&y);
+            let v = if sun {
+                [8.0, 6.0, 4.0]
+            } else {
+                [0.1, 0.2, 0.4]
+            };
+            for (c, chan) in chans.iter_mut().enumerate() {
+                chan[(y * w + x) as usize] = v[c];
+            }
+        }
+    }
+    let img = lapidary::image::ExrImage {
+        width: w,
+        height: h,
+        channels: ["R", "G", "B"]
+            .iter()
+            .zip(chans)
+            .map(|(n, data)| lapidary::image::Channel {
+                name: n.to_string(),
+                data,
+            })
+            .collect(),
+        attributes: vec![],
+    };
+    lapidary::image::write_exr(&path, &img).unwrap();
+    let s = under_sky(&format!(
+        "Map(file: {:?}, intensity: 1.0)",
+        path.display().to_string()
+    ));
+    assert_live(Effect::EnvironmentImportance, "an environment map", &s);
+    // Forced on, a map that calls for it is unchanged.
+    let (n, _) = differences(
+        &film(&s),
+        &film(&forced(&s, Effect::EnvironmentImportance, true)),
+    );
+    assert_eq!(n, 0);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn effects_this_version_does_not_simulate_cannot_be_forced_on() {
+    // A scene that calls for every implemented effect but environment importance: forcing a
+    // later-work slot off touches none of them.
+    let busy = scene(
+        r#"(materials: {
+               "body": (coats: [(ior: 1.5, roughness: 2.0, thickness: 1.0, tint: Rgb(0.9, 0.6, 0.8))],
+                        base: Lambert(albedo: Gray(0.6))),
+               "vein": (coats: [(ior: 1.5, roughness: 4.0)], base: Lambert(albedo: Gray(0.9)), model: Course),
+               "glitter": (base: Conductor(metal: Silver, roughness: 2.0)) },
+            body: (ior: 1.55, roughness: 3.0,
+                   medium: (colour: Srgb(0.9, 0.7, 0.6), distance: 1.0, scattering: (2.0, 2.0, 2.0))),
+            surface: Overlay(
+                under: Switch(by: Marble(scale: 0.5),
+                              stops: [(0.0, Material("body")), (0.3, Body), (0.6, Material("vein"))],
+                              blend: 0.1),
+                over: Voronoi(scale: 0.06, fill: 0.1, entries: [(1.0, Material("glitter"))],
+                              bump: Cone(half_angle: 20.0))),
+            stage: (camera: Perspective(from: (0.0, 2.6, 4.2), to: (0.0, 0.15, 0.0), fov: 30.0,
+                                        aperture: 0.05)))"#,
+    );
+    let called: Vec<Effect> = busy.effects.iter().collect();
+    assert_eq!(
+        called.len(),
+        8,
+        "the scene should call for eight effects: {called:?}"
+    );
+    let auto = film(&busy);
+    for effect in Effect::ALL.into_iter().filter(|e| !e.implemented()) {
+        let mut s = busy.clone();
+        let mut acc = Accuracy::default();
+        acc.force(Effect::Absorption, false); // set first: must not be applied either
+        acc.force(effect, true);
+        let err = s.set_accuracy(&acc, "test").unwrap_err().0;
+        assert!(
+            err.contains("does not simulate") && err.contains(effect.name()),
+            "{effect}: {err}"
+        );
+        assert_eq!(s, busy, "{effect}: a refused knob changed the scene");
+        let knobs: Knobs = format!("{}=on", effect.name()).parse().unwrap();
+        let err = knobs.apply(&mut s, "test").unwrap_err().0;
+        assert!(err.contains("does not simulate"), "{effect}: {err}");
+        assert_eq!(s, busy);
+
+        assert_untouched(effect, "a scene calling for eight other effects", &busy);
+        let off = forced(&busy, effect, false);
+        assert!(called.iter().all(|e| off.effects.on(*e)));
+        let (n, first) = differences(&auto, &film(&off));
+        assert_eq!(n, 0, "{effect} forced off: {}", first.unwrap_or_default());
+    }
+}
