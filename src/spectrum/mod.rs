@@ -9,8 +9,9 @@
 //! - [`RgbSample`] with [`RgbWavelengths`] — the RGB variant: three linear Rec.709 channels and no
 //!   wavelengths at all (a zero-sized type). Its arithmetic is exactly the renderer's arithmetic
 //!   before the split, so RGB renders are bit-identical to it.
-//! - a hero-wavelength variant (issue 19): four wavelengths drawn per camera path (Wilkie et al.,
-//!   "Hero Wavelength Spectral Sampling", EGSR 2014), its value a radiance at each.
+//! - [`HeroSample`] with [`wavelengths::HeroWavelengths`] — the spectral variant (issue 19): four
+//!   wavelengths drawn per camera path (Wilkie et al., "Hero Wavelength Spectral Sampling", EGSR
+//!   2014), its value a radiance at each ([`hero`]).
 //!
 //! **Why monomorphised generics.** The variant is a type parameter (`trace::<RgbSample>`), resolved
 //! at compile time, as Mitsuba 3 compiles one renderer per variant. A scene that needs no spectral
@@ -19,9 +20,11 @@
 //! dispatch or a widest-case layout on every multiply of the hot path. The cost is compile time and
 //! code size for each variant, paid only by the variants the binary instantiates.
 
+pub mod hero;
 pub mod rgb;
 pub mod wavelengths;
 
+pub use hero::HeroSample;
 pub use rgb::{CHANNELS, RgbSample};
 
 use crate::color::Rgb;
@@ -74,6 +77,13 @@ pub trait Spectral:
     /// A stored unbounded quantity (radiance, absorption coefficient, complex IOR part) at the
     /// wavelengths.
     fn from_unbounded(c: Rgb, lambda: &Self::Wavelengths) -> Self;
+    /// A stored emitted radiance (a light's or the sky's colour) at the wavelengths: for a
+    /// spectral variant the illuminant form, so that a grey light is D65-shaped and renders
+    /// white; the same as [`Spectral::from_unbounded`] by default (and in the RGB variant).
+    #[inline]
+    fn from_illuminant(c: Rgb, lambda: &Self::Wavelengths) -> Self {
+        Self::from_unbounded(c, lambda)
+    }
     /// The film colour of a path's radiance estimate carried at `lambda` (for a spectral variant
     /// this divides by the wavelengths' density and projects onto the colour matching functions).
     fn to_rgb(self, lambda: &Self::Wavelengths) -> Rgb;

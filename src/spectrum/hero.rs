@@ -1,0 +1,232 @@
+//! The spectral variant of transported light (issue 19): a value at each of the four wavelengths
+//! a path carries ([`HeroWavelengths`]), hero-wavelength spectral sampling (Wilkie, Nawaz, Droske,
+//! Weidlich & Hanika, "Hero Wavelength Spectral Sampling", EGSR 2014).
+//!
+//! **Stored colour to transported light.** A recipe's RGB reflectance becomes the sigmoid-
+//! polynomial spectrum of Jakob & Hanika 2019 ([`super::rgb2spec::reflectance`]: ≤ 1 at every
+//! wavelength, a grey exactly flat); an unbounded quantity (an absorption coefficient, a part of
+//! a complex index) `scale · s(λ)` ([`super::rgb2spec::unbounded`]); emitted radiance the
+//! illuminant form `scale · s(λ) · D65(λ)` ([`super::rgb2spec::illuminant`]), so that a grey light
+//! is D65-shaped and renders white.
+//!
+//! **To the film.** A path's estimate `L(λ_i)` at its wavelengths becomes CIE 1931 XYZ by
+//! `(1/4) Σ_i L(λ_i) (x̄, ȳ, z̄)(λ_i) / p(λ_i)`, divided by `∫ȳ` (so that a constant spectrum 1
+//! has `Y = 1`, as [`super::cie::spectrum_to_xyz`]), then linear Rec.709 through
+//! [`super::cie::xyz_to_linear_srgb`]; wavelengths whose density is 0 (terminated secondaries)
+//! add nothing, and the hero's density, divided by 4 at termination, makes it stand for the four.
+
+use super::wavelengths::{HeroWavelengths, N};
+use super::{Spectral, cie, rgb2spec};
+use crate::color::Rgb;
+use std::ops::{Add, AddAssign, Div, Mul, MulAssign, Sub};
+
+/// Transported light in the spectral variant: one value per carried wavelength (radiance,
+/// throughput, reflectance … at `lambda[i]` of the path's [`HeroWavelengths`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct HeroSample(pub [f32; N]);
+
+impl HeroSample {
+    /// Combines two values wavelength by wavelength.
+    #[inline]
+    fn zip(self, o: Self, f: impl Fn(f32, f32) -> f32) -> Self {
+        HeroSample(std::array::from_fn(|i| f(self.0[i], o.0[i])))
+    }
+
+    /// The spectrum `f` (a function of the wavelength in nm) at the wavelengths.
+    #[inline]
+    pub fn at(lambda: &HeroWavelengths, f: impl Fn(f32) -> f32) -> Self {
+        HeroSample(lambda.lambda.map(f))
+    }
+}
+
+impl Add for HeroSample {
+    type Output = Self;
+    #[inline]
+    fn add(self, o: Self) -> Self {
+        self.zip(o, |a, b| a + b)
+    }
+}
+
+impl AddAssign for HeroSample {
+    #[inline]
+    fn add_assign(&mut self, o: Self) {
+        *self = *self + o;
+    }
+}
+
+impl Sub for HeroSample {
+    type Output = Self;
+    #[inline]
+    fn sub(self, o: Self) -> Self {
+        self.zip(o, |a, b| a - b)
+    }
+}
+
+impl Mul for HeroSample {
+    type Output = Self;
+    #[inline]
+    fn mul(self, o: Self) -> Self {
+        self.zip(o, |a, b| a * b)
+    }
+}
+
+impl MulAssign for HeroSample {
+    #[inline]
+    fn mul_assign(&mut self, o: Self) {
+        *self = *self * o;
+    }
+}
+
+impl Mul<f32> for HeroSample {
+    type Output = Self;
+    #[inline]
+    fn mul(self, s: f32) -> Self {
+        HeroSample(self.0.map(|a| a * s))
+    }
+}
+
+impl MulAssign<f32> for HeroSample {
+    #[inline]
+    fn mul_assign(&mut self, s: f32) {
+        *self = *self * s;
+    }
+}
+
+impl Div<f32> for HeroSample {
+    type Output = Self;
+    #[inline]
+    fn div(self, s: f32) -> Self {
+        HeroSample(self.0.map(|a| a / s))
+    }
+}
+
+impl Spectral for HeroSample {
+    type Wavelengths = HeroWavelengths;
+    const WAVELENGTH_DIMENSIONS: u32 = 1;
+    const ZERO: Self = HeroSample([0.0; N]);
+    const ONE: Self = HeroSample([1.0; N]);
+    const CHANNELS: usize = N;
+
+    #[inline]
+    fn splat(v: f32) -> Self {
+        HeroSample([v; N])
+    }
+
+    #[inline]
+    fn sample_wavelengths(u: f32) -> HeroWavelengths {
+        HeroWavelengths::sample(u)
+    }
+
+    fn from_reflectance(c: Rgb, lambda: &HeroWavelengths) -> Self {
+        let s = rgb2spec::reflectance([c.r, c.g, c.b]);
+        HeroSample::at(lambda, |l| s.eval(l))
+    }
+
+    fn from_unbounded(c: Rgb, lambda: &HeroWavelengths) -> Self {
+        let (scale, s) = rgb2spec::unbounded([c.r, c.g, c.b]);
+        HeroSample::at(lambda, |l| scale * s.eval(l))
+    }
+
+    fn from_illuminant(c: Rgb, lambda: &HeroWavelengths) -> Self {
+        let (scale, s) = rgb2spec::illuminant([c.r, c.g, c.b]);
+        HeroSample::at(lambda, |l| scale * s.eval(l) * rgb2spec::d65_normalised(l))
+    }
+
+    fn to_rgb(self, lambda: &HeroWavelengths) -> Rgb {
+        let mut xyz = [0.0f64; 3];
+        for i in 0..N {
+            let p = lambda.pdf[i];
+            if p > 0.0 {
+                let w = f64::from(self.0[i]) / f64::from(p);
+                let bar = cie::xyz_bar(lambda.lambda[i]).to_array();
+                for (x, b) in xyz.iter_mut().zip(bar) {
+                    *x += w * f64::from(b);
+                }
+            }
+        }
+        let norm = N as f64 * f64::from(cie::CIE_Y_INTEGRAL);
+        let v = glam::Vec3::new(
+            (xyz[0] / norm) as f32,
+            (xyz[1] / norm) as f32,
+            (xyz[2] / norm) as f32,
+        );
+        let rgb = cie::xyz_to_linear_srgb(v);
+        Rgb::new(rgb.x, rgb.y, rgb.z)
+    }
+
+    #[inline]
+    fn channel(self, i: usize) -> f32 {
+        self.0[i]
+    }
+
+    #[inline]
+    fn map(self, f: impl Fn(f32) -> f32) -> Self {
+        HeroSample(self.0.map(f))
+    }
+
+    #[inline]
+    fn max_channel(self) -> f32 {
+        self.0.iter().copied().fold(f32::NEG_INFINITY, f32::max)
+    }
+
+    #[inline]
+    fn average(self) -> f32 {
+        self.0.iter().sum::<f32>() / N as f32
+    }
+
+    #[inline]
+    fn is_black(self) -> bool {
+        self.0.iter().all(|&c| c == 0.0)
+    }
+
+    #[inline]
+    fn is_valid(self) -> bool {
+        self.0.iter().all(|&c| c.is_finite() && c >= 0.0)
+    }
+
+    #[inline]
+    fn terminate_secondary(lambda: &mut HeroWavelengths) {
+        lambda.terminate_secondary();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn arithmetic_is_per_wavelength() {
+        let a = HeroSample([1.0, 2.0, 3.0, 4.0]);
+        let b = HeroSample([0.5, 0.25, 2.0, 0.0]);
+        assert_eq!((a * b).0, [0.5, 0.5, 6.0, 0.0]);
+        assert_eq!((a + b).0, [1.5, 2.25, 5.0, 4.0]);
+        assert_eq!((a - b).0, [0.5, 1.75, 1.0, 4.0]);
+        assert_eq!((a * 2.0).0, [2.0, 4.0, 6.0, 8.0]);
+        assert_eq!((a / 2.0).0, [0.5, 1.0, 1.5, 2.0]);
+        assert_eq!(a.max_channel(), 4.0);
+        assert_eq!(a.average(), 2.5);
+        assert!(!HeroSample([1.0, -0.0, 0.0, f32::NAN]).is_valid());
+        assert!(HeroSample::ZERO.is_black());
+    }
+
+    #[test]
+    fn a_grey_reflectance_is_flat_at_every_wavelength() {
+        let lambda = HeroWavelengths::sample(0.41);
+        let v = HeroSample::from_reflectance(Rgb::new(0.3, 0.3, 0.3), &lambda);
+        for c in v.0 {
+            assert!((c - 0.3).abs() < 1e-6, "{v:?}");
+        }
+        let white = HeroSample::from_reflectance(Rgb::new(1.0, 1.0, 1.0), &lambda);
+        assert_eq!(white, HeroSample::ONE);
+    }
+
+    #[test]
+    fn terminated_wavelengths_add_nothing() {
+        let mut lambda = HeroWavelengths::sample(0.2);
+        let full = HeroSample([1.0, 1.0, 1.0, 1.0]);
+        lambda.terminate_secondary();
+        // Only the hero counts, four times over.
+        let only_hero = HeroSample([1.0, 0.0, 0.0, 0.0]).to_rgb(&lambda);
+        assert_eq!(full.to_rgb(&lambda), only_hero);
+    }
+}
