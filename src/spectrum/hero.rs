@@ -118,17 +118,17 @@ impl Spectral for HeroSample {
     }
 
     fn from_reflectance(c: Rgb, lambda: &HeroWavelengths) -> Self {
-        let s = rgb2spec::reflectance([c.r, c.g, c.b]);
+        let s = rgb2spec::reflectance(c.0);
         HeroSample::at(lambda, |l| s.eval(l))
     }
 
     fn from_unbounded(c: Rgb, lambda: &HeroWavelengths) -> Self {
-        let (scale, s) = rgb2spec::unbounded([c.r, c.g, c.b]);
+        let (scale, s) = rgb2spec::unbounded(c.0);
         HeroSample::at(lambda, |l| scale * s.eval(l))
     }
 
     fn from_illuminant(c: Rgb, lambda: &HeroWavelengths) -> Self {
-        let (scale, s) = rgb2spec::illuminant([c.r, c.g, c.b]);
+        let (scale, s) = rgb2spec::illuminant(c.0);
         HeroSample::at(lambda, |l| scale * s.eval(l) * rgb2spec::d65_normalised(l))
     }
 

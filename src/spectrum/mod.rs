@@ -13,6 +13,9 @@
 //!   wavelengths drawn per camera path (Wilkie et al., "Hero Wavelength Spectral Sampling", EGSR
 //!   2014), its value a radiance at each ([`hero`]).
 //!
+//! Building blocks of the spectral variant: [`cie`] (CIE 1931 colour-matching functions, D65, the
+//! sRGB matrices) and [`rgb2spec`] (RGB colours as smooth spectra, Jakob & Hanika 2019).
+//!
 //! **Why monomorphised generics.** The variant is a type parameter (`trace::<RgbSample>`), resolved
 //! at compile time, as Mitsuba 3 compiles one renderer per variant. A scene that needs no spectral
 //! effect runs code in which the spectral type does not occur: no branch on a runtime "mode", no
@@ -20,8 +23,10 @@
 //! dispatch or a widest-case layout on every multiply of the hot path. The cost is compile time and
 //! code size for each variant, paid only by the variants the binary instantiates.
 
+pub mod cie;
 pub mod hero;
 pub mod rgb;
+pub mod rgb2spec;
 pub mod wavelengths;
 
 pub use hero::HeroSample;
