@@ -352,8 +352,8 @@ fn walk_is_called_only_for_a_smooth_boundary_with_scatterers_and_lights() {
 /// paths a pixel, 686 paths through the stone lit none: 0 ± 0 against the walk's 0.019): the walk
 /// (MIS) at 2¹⁶ paths per pixel against BSDF sampling at 2²¹, the medium body above under the
 /// light of radius 0.5; equal within a z-test at α = 0.01 (Šidák over 3 pixels). Measured: (12,
-/// 13) 0.02370 ± 0.00048 vs 0.02419 ± 0.00048; (13, 12) 0.02183 ± 0.00020 vs 0.02312 ± 0.00047;
-/// (12, 12) 0.03841 ± 0.00067 vs 0.03860 ± 0.00061 (≈ 25 s).
+/// 13) 0.02462 ± 0.00071 vs 0.02419 ± 0.00048; (13, 12) 0.02214 ± 0.00036 vs 0.02312 ± 0.00047;
+/// (12, 12) 0.03895 ± 0.00079 vs 0.03860 ± 0.00061 (|z| 0.5, 1.7, 0.4; ≈ 25 s).
 #[test]
 #[ignore = "heavy: cargo test --release --test platelets -- --ignored --nocapture"]
 fn silhouette_pixels_converge() {
