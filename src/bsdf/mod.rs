@@ -31,6 +31,7 @@ pub mod layered;
 pub mod masking;
 pub mod measure;
 pub mod memo;
+pub mod metal_spectra;
 pub mod microfacet;
 pub mod names;
 pub mod oren_nayar;
