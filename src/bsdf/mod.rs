@@ -24,6 +24,7 @@
 //!   `f > 0` for a direction that `sample` can produce, its `pdf > 0`.
 
 pub mod dielectric;
+pub mod dispersion;
 pub mod fresnel;
 pub mod interface_energy;
 pub mod lambert;
