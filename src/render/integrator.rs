@@ -41,7 +41,7 @@
 //! inside a smooth boundary, and at a floor hit under a smooth stone, a manifold walk samples a
 //! light through the boundary ([`super::manifold`]); `PathState::manifold` keeps the vertex while
 //! the BSDF-sampled continuation follows the walk's chain, so a light it reaches is weighted
-//! against the walk ([`super::direct::manifold_weight`]).
+//! against the walk (`direct::manifold_weight`).
 //!
 //! **Variants.** [`trace`] is generic over the transported light `S` and monomorphised per variant
 //! ([`crate::spectrum`]); the film receives the path's radiance as a stored colour.

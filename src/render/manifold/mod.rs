@@ -67,8 +67,7 @@ pub use light::{
     walk_probability,
 };
 pub use walk::{
-    Chain, Connection, Entry, Exit, MAX_ITERATIONS, MAX_STEP, STAGES, TOLERANCE, exit, jacobian,
-    solve,
+    Chain, Connection, Entry, Exit, MAX_ITERATIONS, MAX_STEP, STAGES, TOLERANCE, exit, solve,
 };
 
 use crate::light::Area;

@@ -386,29 +386,6 @@ pub fn solve(
     })
 }
 
-/// `|dω0/dA2|` (world units⁻²) of the path from `x0` along `d` through `chain` to the light point
-/// `x2` on a light of unit normal `n_light` (module docs); `None` if a perturbed ray does not
-/// follow the chain or the map is singular.
-pub fn jacobian(
-    world: &World,
-    x0: Vec3,
-    d: Vec3,
-    x2: Vec3,
-    n_light: Vec3,
-    eta: f32,
-    chain: Chain,
-) -> Option<f32> {
-    let (h, _, _) = last(world, x0, d, eta, chain)?;
-    let problem = Problem {
-        world,
-        x0,
-        x2,
-        eta,
-        chain,
-    };
-    problem.measure(d, n_light, h.p, h.ns)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
