@@ -8,7 +8,7 @@
 //! path, to rounding: the integrator, path state and shading context do not depend on RGB.
 
 use glam::{Vec2, Vec3};
-use lapidary::bsdf::{Bsdf, BsdfSample, Bxdf, LobeFlags, SmoothDielectric, TransportMode};
+use lapidary::bsdf::{Bsdf, BsdfSample, Bxdf, Scatter, SmoothDielectric, TransportMode};
 use lapidary::color::Rgb;
 use lapidary::geometry::Ray;
 use lapidary::recipe::GemRecipe;
@@ -121,19 +121,17 @@ impl Spectral for Grey4 {
 }
 
 /// The RGB models seen through `Grey4`.
-impl Bxdf<Grey4> for Bsdf {
-    fn flags(&self) -> LobeFlags {
-        Bxdf::<RgbSample>::flags(self)
-    }
-    fn eval_mode(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> Grey4 {
+impl Scatter<Grey4> for Bsdf {
+    fn eval_at(&self, wo: Vec3, wi: Vec3, mode: TransportMode, _: &[f32; 4]) -> Grey4 {
         Grey4::grey(Bxdf::<RgbSample>::eval_mode(self, wo, wi, mode))
     }
-    fn sample_mode(
+    fn sample_at(
         &self,
         wo: Vec3,
         uc: f32,
         u: Vec2,
         mode: TransportMode,
+        _: &[f32; 4],
     ) -> Option<BsdfSample<Grey4>> {
         let s = Bxdf::<RgbSample>::sample_mode(self, wo, uc, u, mode)?;
         Some(BsdfSample {
@@ -145,9 +143,10 @@ impl Bxdf<Grey4> for Bsdf {
             flags: s.flags,
             eta: s.eta,
             pdf_is_proportional: s.pdf_is_proportional,
+            terminate_secondary: false,
         })
     }
-    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+    fn pdf_at(&self, wo: Vec3, wi: Vec3, _: &[f32; 4]) -> f32 {
         Bxdf::<RgbSample>::pdf(self, wo, wi)
     }
 }

@@ -48,6 +48,9 @@ pub struct RoughDielectric {
     /// Optional multiple-scattering lobe that returns the energy single scattering loses,
     /// reciprocally ([`InterfaceEnergy`]).
     pub energy: Option<Arc<InterfaceEnergy>>,
+    /// The interface's dispersion, used by spectral paths (`None`: the same `eta` at every
+    /// wavelength; `eta` is then its value at the d line).
+    pub dispersion: Option<super::dispersion::Dispersion>,
 }
 
 impl RoughDielectric {
@@ -57,6 +60,7 @@ impl RoughDielectric {
             distribution,
             eta,
             energy: None,
+            dispersion: None,
         }
     }
 

@@ -40,6 +40,25 @@ pub enum Ior {
     },
 }
 
+/// A dispersive interface between a body and the medium outside it: the relative index
+/// `η(λ) = n_inside(λ) / n_outside` a spectral path refracts with (the RGB variant keeps the
+/// interface's `eta` at the d line).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Dispersion {
+    /// The body's index as a function of the wavelength.
+    pub inside: Ior,
+    /// The (non-dispersive) index of the medium outside.
+    pub outside: f32,
+}
+
+impl Dispersion {
+    /// The relative index inside / outside at `lambda_nm`.
+    #[inline]
+    pub fn eta_at(&self, lambda_nm: f32) -> f32 {
+        self.inside.at(lambda_nm) / self.outside
+    }
+}
+
 impl Ior {
     /// The two-term Cauchy law with index `n_d` at the d line and Abbe number `v_d` (module docs);
     /// `None` unless `n_d > 1` and `v_d > 0` are finite.

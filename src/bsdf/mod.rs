@@ -38,6 +38,7 @@ pub mod names;
 pub mod oren_nayar;
 pub mod record;
 pub mod smooth_dielectric;
+pub mod spectral;
 pub mod table;
 pub mod torrance_sparrow;
 
@@ -51,6 +52,7 @@ pub use microfacet::{Distribution, Masking, MicrofacetDistribution};
 pub use oren_nayar::OrenNayar;
 pub use record::{BsdfSample, Lobe, LobeFlags, LobeKind, TransportMode};
 pub use smooth_dielectric::SmoothDielectric;
+pub use spectral::Scatter;
 pub use torrance_sparrow::TorranceSparrow;
 
 use crate::spectrum::{RgbSample, Spectral};
@@ -171,7 +173,7 @@ pub const F_FLUSH: f32 = 1e-30;
 
 /// Flushes channels below [`F_FLUSH`] to 0.
 #[inline]
-pub fn flush_tiny(f: RgbSample) -> RgbSample {
+pub fn flush_tiny<S: Spectral>(f: S) -> S {
     f.map(|v| if v < F_FLUSH { 0.0 } else { v })
 }
 

@@ -27,7 +27,7 @@ pub struct OrenNayar {
 impl OrenNayar {
     /// The part of `f` that multiplies `ρ/π` (direct term) and `ρ²/π` (interreflection), as a pair.
     #[inline]
-    fn factors(&self, wo: Vec3, wi: Vec3) -> (f32, f32) {
+    pub(crate) fn factors(&self, wo: Vec3, wi: Vec3) -> (f32, f32) {
         let s2 = self.sigma * self.sigma;
         let (st_i, st_o) = (sin2_theta(wi).sqrt(), sin2_theta(wo).sqrt());
         let (ti, to) = (st_i.atan2(wi.z), st_o.atan2(wo.z));

@@ -152,6 +152,11 @@ pub struct BsdfSample<S: Spectral = RgbSample> {
     /// exact density has no closed form): `weight` is unbiased, but `pdf` must not be used for
     /// MIS against another strategy as if it were exact.
     pub pdf_is_proportional: bool,
+    /// True when the sample refracted through a dispersive interface with the hero wavelength's
+    /// index: the path must keep only its hero wavelength from here on
+    /// ([`Spectral::terminate_secondary`]); the secondaries' values in `f` and `weight` are 0.
+    /// Always false in the RGB variant.
+    pub terminate_secondary: bool,
 }
 
 impl<S: Spectral> BsdfSample<S> {
@@ -173,6 +178,7 @@ impl<S: Spectral> BsdfSample<S> {
             flags: lobe.kind.flags(),
             eta: 1.0,
             pdf_is_proportional: false,
+            terminate_secondary: false,
         })
     }
 

@@ -10,6 +10,7 @@
 //! the relative IOR of the side below the macro normal (`z < 0`) over the side above, as for the
 //! rough interface. `eval` and `pdf` are 0: a delta is only reached by sampling.
 
+use super::dispersion::Dispersion;
 use super::{BsdfSample, Bxdf, Lobe, LobeFlags, LobeKind, TransportMode, fresnel, refract};
 use crate::spectrum::RgbSample;
 use glam::{Vec2, Vec3};
@@ -17,14 +18,30 @@ use glam::{Vec2, Vec3};
 /// A smooth dielectric interface.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SmoothDielectric {
-    /// Relative IOR, below / above (> 0).
+    /// Relative IOR, below / above (> 0); for a dispersive interface its value at the d line.
     pub eta: f32,
+    /// The interface's dispersion, used by spectral paths (`None`: the same `eta` at every
+    /// wavelength).
+    pub dispersion: Option<Dispersion>,
 }
 
 impl SmoothDielectric {
     /// An interface with relative IOR `eta` (below / above).
     pub fn new(eta: f32) -> Self {
-        SmoothDielectric { eta }
+        SmoothDielectric {
+            eta,
+            dispersion: None,
+        }
+    }
+
+    /// The same interface with the relative index `law.eta_at(λ)` for spectral paths (and its
+    /// value at the d line for RGB paths).
+    pub fn with_dispersion(mut self, law: Dispersion) -> Self {
+        if law.inside.is_dispersive() {
+            self.eta = law.eta_at(super::dispersion::LAMBDA_D);
+            self.dispersion = Some(law);
+        }
+        self
     }
 }
 

@@ -33,6 +33,16 @@ pub struct Compensation {
     pub f0: RgbSample,
 }
 
+/// A measured metal seen from a host medium, for spectral paths: the facet's Fresnel factor at
+/// wavelength `λ` is the conductor's with the relative index `(n + i k)(λ) / host`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpectralMetal {
+    /// The metal ([`super::Metal::nk_at`]).
+    pub metal: super::Metal,
+    /// Index of the medium above the metal (1: air; a body's or varnish's index).
+    pub host: f32,
+}
+
 /// A micro-facet reflection lobe over the upper hemisphere.
 #[derive(Clone, Debug, PartialEq)]
 pub struct TorranceSparrow {
@@ -42,6 +52,8 @@ pub struct TorranceSparrow {
     pub fresnel: Fresnel,
     /// Optional multiple-scattering compensation.
     pub compensation: Option<Compensation>,
+    /// The measured metal behind `fresnel`, when there is one (spectral paths use its tables).
+    pub metal: Option<SpectralMetal>,
 }
 
 impl TorranceSparrow {
@@ -51,6 +63,7 @@ impl TorranceSparrow {
             distribution,
             fresnel,
             compensation: None,
+            metal: None,
         }
     }
 
@@ -92,7 +105,7 @@ impl TorranceSparrow {
 
     /// The half vector of two upper-hemisphere directions, `None` when undefined (`wo = −wi`).
     #[inline]
-    fn half(wo: Vec3, wi: Vec3) -> Option<Vec3> {
+    pub(crate) fn half(wo: Vec3, wi: Vec3) -> Option<Vec3> {
         let h = wo + wi;
         let l2 = h.length_squared();
         (l2 > 1e-30 && h.z > 0.0).then(|| h / l2.sqrt())

@@ -58,6 +58,13 @@ fn stack_summary(s: &StackDesc) -> (String, String) {
             ConductorIor::Complex { n, k } => {
                 format!("conductor m {roughness}° n {:.2?} k {:.2?}", n.0, k.0)
             }
+            ConductorIor::Measured(m) => {
+                let (n, k) = m.nk();
+                format!(
+                    "conductor m {roughness}° n {:.2?} k {:.2?} ({m:?}, measured n, k)",
+                    n.0, k.0
+                )
+            }
             ConductorIor::Perfect => format!("perfect mirror m {roughness}°"),
         },
     };

@@ -45,6 +45,11 @@ pub struct KnobArgs {
     /// Crystal-facet bump: on or off (same as `--effect facet-bump=…`).
     #[arg(long, value_parser = |s: &str| alias_arg(Effect::FacetBump, s))]
     bump: Option<(Effect, bool)>,
+    /// Spectral transport (four wavelengths per path) for a scene that does not call for it, or
+    /// RGB for one that does: `--spectral` alone is `on` (same as `--effect spectral=…`).
+    #[arg(long, num_args = 0..=1, default_missing_value = "on",
+          value_parser = |s: &str| alias_arg(Effect::Spectral, s))]
+    spectral: Option<(Effect, bool)>,
     /// Force any effect's code on or off, e.g. `--effect depth-of-field=off` (repeatable;
     /// `lapidary info` lists the effects).
     #[arg(long = "effect", value_parser = effect_arg)]
@@ -65,7 +70,7 @@ impl KnobArgs {
             calibration: self.calibration,
             effects: vec![],
         };
-        let aliases = [self.t_term, self.absorption, self.bump];
+        let aliases = [self.t_term, self.absorption, self.bump, self.spectral];
         for (e, on) in aliases
             .into_iter()
             .flatten()

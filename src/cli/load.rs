@@ -145,7 +145,7 @@ mod tests {
         assert!(e.to_string().contains(":1:26: unknown material"), "{e}");
         let path = scratch("gem2.ron", GEM);
         let mut knobs = Accuracy::default();
-        knobs.force(Effect::Spectral, true);
+        knobs.force(Effect::Fluorescence, true);
         let e = load_scene(&path, &knobs, None).unwrap_err().to_string();
         assert!(
             e.starts_with(&format!("{}: ", path.display())) && e.contains("does not simulate"),

@@ -4,7 +4,7 @@
 //! light from the upper left. Stochastic switch bands show as dithering: every pixel draws its own
 //! random number from `(seed, pixel)`.
 
-use crate::bsdf::{Base, ConductorIor, StackDesc};
+use crate::bsdf::{Base, StackDesc};
 use crate::image::outputs::{Format, OutputPlan};
 use crate::sampler::{hash_words, to_unit_f32};
 use crate::scene::Accuracy;
@@ -108,11 +108,11 @@ pub enum Colours {
 pub fn preview_colour(stack: &StackDesc) -> [u8; 3] {
     let base = match &stack.base {
         Base::Lambert { albedo } | Base::OrenNayar { albedo, .. } => *albedo,
-        Base::Conductor { ior, .. } => match ior {
-            ConductorIor::Complex { n, k } => n.zip(*k, |n, k| {
+        Base::Conductor { ior, .. } => match ior.rgb() {
+            Some((n, k)) => n.zip(k, |n, k| {
                 ((n - 1.0).powi(2) + k * k) / ((n + 1.0).powi(2) + k * k)
             }),
-            ConductorIor::Perfect => crate::color::Rgb::ONE,
+            None => crate::color::Rgb::ONE,
         },
     };
     let rgb = stack.coats.iter().fold(base, |c, coat| {
@@ -292,6 +292,7 @@ fn draw_legend(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bsdf::ConductorIor;
 
     #[test]
     fn planes_parse_and_reject_nonsense() {

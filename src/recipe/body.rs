@@ -3,7 +3,9 @@
 //!
 //! ```ron
 //! body: (
-//!     ior: 1.52,                       // absolute IOR of the stone, 1.0001 ..= 4
+//!     ior: 1.52,                       // absolute IOR of the stone, 1.0001 ..= 4 (at the d line)
+//!     dispersion: Abbe(58.0),          // optional: Abbe(V_d) | Cauchy(b: µm², c: µm⁴)
+//!                                      //   | Sellmeier(b: (B1, B2, B3), c: (C1, C2, C3))
 //!     roughness: 2.0,                  // optional: RMS slope angle, degrees (or `alpha`); default smooth
 //!     distribution: Ggx,               // optional: Blinn | Beckmann | Ggx (default Ggx)
 //!     masking: Smith,                  // optional: VCavity | Smith | SmithSeparable (default Smith)
@@ -22,6 +24,7 @@
 
 use super::color::ColorDesc;
 use super::platelets::PlateletsDesc;
+use crate::bsdf::dispersion::{Ior, LAMBDA_D};
 use crate::bsdf::{Distribution, Masking};
 use crate::color::Rgb;
 use crate::medium::phase::G_LIMIT;
@@ -128,6 +131,10 @@ pub struct BodyDesc {
     /// Masking of a rough boundary (default Smith, Walter et al. 2007).
     #[serde(default = "default_masking")]
     pub masking: Masking,
+    /// How the IOR changes with the wavelength; `None`: it does not. A dispersive body turns
+    /// spectral transport on (its RGB render uses `ior`, the index at the d line).
+    #[serde(default)]
+    pub dispersion: Option<DispersionDesc>,
     /// The interior; `None` is clear (nothing absorbs or scatters).
     #[serde(default)]
     pub medium: Option<MediumDesc>,
@@ -184,7 +191,95 @@ impl PhaseDesc {
     }
 }
 
+/// A body's dispersion law (the index at the d line, 587.56 nm, is the body's `ior`).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum DispersionDesc {
+    /// Abbe number `V_d = (n_d − 1)/(n_F − n_C)`, 5 ..= 200 (a two-term Cauchy law through `ior`).
+    Abbe(f32),
+    /// `n(λ) = A + B/λ² + C/λ⁴` (λ in µm) with `A` chosen so that `n(587.56 nm) = ior`.
+    Cauchy {
+        /// `B`, µm², 0 ..= 0.1.
+        b: f32,
+        /// `C`, µm⁴, 0 ..= 0.01 (default 0).
+        #[serde(default)]
+        c: f32,
+    },
+    /// `n² = 1 + Σ Bᵢ λ²/(λ² − Cᵢ)` (λ in µm; `Cᵢ` in µm²): its index at 587.56 nm must equal
+    /// `ior` within 0.001.
+    Sellmeier {
+        /// `B₁, B₂, B₃`, each 0 ..= 10.
+        b: (f32, f32, f32),
+        /// `C₁, C₂, C₃`, µm², each 0 ..= 1000.
+        c: (f32, f32, f32),
+    },
+}
+
 impl BodyDesc {
+    /// The body's index as a function of the wavelength (`None`: not dispersive), or what is
+    /// wrong with the law.
+    pub fn ior_law(&self) -> Result<Option<Ior>, String> {
+        let Some(d) = self.dispersion else {
+            return Ok(None);
+        };
+        let law = match d {
+            DispersionDesc::Abbe(v) => {
+                if !(5.0..=200.0).contains(&v) {
+                    return Err(format!(
+                        "body.dispersion: Abbe number {v} is out of range: allowed 5 ..= 200"
+                    ));
+                }
+                Ior::from_abbe(self.ior, v).ok_or("body.dispersion: Abbe needs ior > 1")?
+            }
+            DispersionDesc::Cauchy { b, c } => {
+                if !(0.0..=0.1).contains(&b) || !(0.0..=0.01).contains(&c) {
+                    return Err(format!(
+                        "body.dispersion: Cauchy b {b} µm², c {c} µm⁴ out of range: allowed \
+                         b 0 ..= 0.1, c 0 ..= 0.01"
+                    ));
+                }
+                let l2 = (LAMBDA_D * 1e-3).powi(2);
+                Ior::Cauchy {
+                    a: self.ior - b / l2 - c / (l2 * l2),
+                    b,
+                    c,
+                }
+            }
+            DispersionDesc::Sellmeier { b, c } => {
+                let (b, c) = ([b.0, b.1, b.2], [c.0, c.1, c.2]);
+                if b.iter().any(|v| !(0.0..=10.0).contains(v))
+                    || c.iter().any(|v| !(0.0..=1000.0).contains(v))
+                {
+                    return Err(format!(
+                        "body.dispersion: Sellmeier b {b:?}, c {c:?} out of range: allowed \
+                         each B 0 ..= 10, each C 0 ..= 1000 µm²"
+                    ));
+                }
+                let law = Ior::Sellmeier { b, c };
+                let n_d = law.at(LAMBDA_D);
+                if (n_d - self.ior).abs() > 1e-3 {
+                    return Err(format!(
+                        "body.dispersion: the Sellmeier law gives {n_d:.5} at 587.56 nm but \
+                         ior is {}: they must agree within 0.001",
+                        self.ior
+                    ));
+                }
+                law
+            }
+        };
+        // Every visible wavelength must see a proper index (no resonance, 1 < n ≤ 4).
+        for l in (360..=830).step_by(5) {
+            let n = law.at(l as f32);
+            if !(n > 1.0 && n <= BODY_IOR.1) {
+                return Err(format!(
+                    "body.dispersion: the law gives n = {n} at {l} nm: allowed 1 <.. 4 over \
+                     360 ..= 830 nm"
+                ));
+            }
+        }
+        Ok(Some(law))
+    }
+
     /// The boundary's `α` (0: smooth), or what is wrong.
     pub fn alpha(&self) -> Result<f32, String> {
         match (self.roughness, self.alpha) {

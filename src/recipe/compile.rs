@@ -292,6 +292,17 @@ impl Compiler<'_> {
                 return None;
             }
         };
+        let dispersion = match desc.ior_law() {
+            Ok(d) => d,
+            Err(m) => {
+                let at = r
+                    .source
+                    .find_from(at.unwrap_or(0), &["dispersion", ":"])
+                    .or(at);
+                self.errors.push(r.source.error(at, m));
+                return None;
+            }
+        };
         let medium = match &desc.medium {
             None => None,
             Some(m) => match m.coefficients() {
@@ -310,6 +321,7 @@ impl Compiler<'_> {
         let (platelets, platelet_materials) = self.platelets(desc, body_index, at.unwrap_or(0))?;
         let body = Body {
             ior: desc.ior,
+            dispersion,
             alpha,
             distribution: desc.distribution,
             masking: desc.masking,
@@ -319,6 +331,17 @@ impl Compiler<'_> {
         };
         if shown {
             self.effects.turn_on(Effect::Transmission, place.clone());
+            if body.dispersion.is_some() {
+                let d = r
+                    .source
+                    .find_from(at.unwrap_or(0), &["dispersion", ":"])
+                    .or(at);
+                let e = r.source.error(d, "");
+                self.effects.turn_on(
+                    Effect::Spectral,
+                    format!("body.dispersion ({}:{})", e.file, e.line),
+                );
+            }
             if !body.platelets.is_empty() {
                 let p = r
                     .source

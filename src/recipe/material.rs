@@ -281,10 +281,7 @@ impl MaterialDesc {
                 roughness,
                 alpha,
             } => {
-                let preset = |m: Metal| {
-                    let (n, k) = m.nk();
-                    ConductorIor::Complex { n, k }
-                };
+                let preset = ConductorIor::Measured;
                 let ior = match metal {
                     MetalDesc::Gold => preset(Metal::Gold),
                     MetalDesc::Silver => preset(Metal::Silver),

@@ -6,7 +6,7 @@
 use super::path::{PathSample, PathState};
 use super::shading::SurfaceBsdf;
 use super::world::{LightRef, World};
-use crate::bsdf::{Bsdf, Bxdf, power_heuristic};
+use crate::bsdf::{Bsdf, Scatter, power_heuristic};
 use crate::geometry::{Ray, offset_origin};
 use crate::spectrum::Spectral;
 use glam::Vec3;
@@ -37,7 +37,7 @@ pub(super) fn direct_light<S: Spectral>(
     path: &mut PathState<S>,
     out: &mut PathSample,
 ) where
-    Bsdf: Bxdf<S>,
+    Bsdf: Scatter<S>,
 {
     let Some((light, p_pick)) = world.pick_light(u_light) else {
         return;
@@ -52,7 +52,7 @@ pub(super) fn direct_light<S: Spectral>(
     if !sb.admits(ls.wi) || (world.transmission_off && ls.wi.dot(sb.ng) < 0.0) {
         return;
     }
-    let (wi_local, f) = sb.eval::<S>(wo_local, ls.wi);
+    let (wi_local, f) = sb.eval::<S>(wo_local, ls.wi, &path.lambda);
     if f.is_black() {
         return;
     }
@@ -68,10 +68,10 @@ pub(super) fn direct_light<S: Spectral>(
     }
     let p_light = p_pick * ls.pdf;
     let w = match strategy {
-        Strategy::Mis => power_heuristic(p_light, sb.pdf::<S>(wo_local, wi_local)),
+        Strategy::Mis => power_heuristic(p_light, sb.pdf::<S>(wo_local, wi_local, &path.lambda)),
         _ => 1.0,
     };
-    let radiance = S::from_unbounded(ls.radiance, &path.lambda);
+    let radiance = S::from_illuminant(ls.radiance, &path.lambda);
     let c = path.throughput() * f * radiance * (wi_local.z.abs() * w / p_light);
     if c.is_valid() {
         path.l += c;

@@ -62,7 +62,12 @@ impl PixelSums {
             self.depth += f64::from(t);
             self.depth_n += 1;
         }
-        if !s.radiance.is_valid() {
+        let ok = if s.signed {
+            s.radiance.0.iter().all(|v| v.is_finite())
+        } else {
+            s.radiance.is_valid()
+        };
+        if !ok {
             self.dropped += 1;
             return;
         }
@@ -178,6 +183,7 @@ mod tests {
             depth: Some(2.0),
             material: 3,
             rays: 2,
+            signed: false,
         }
     }
 
@@ -206,5 +212,20 @@ mod tests {
         assert_eq!(p.mean()[2], 2.0);
         assert!(p.variance_of_mean().iter().all(|v| v.is_finite()));
         assert_eq!(p.mean_albedo(), [0.5; 3]);
+    }
+
+    /// A spectral sample's Rec.709 image may have a negative channel (a saturated colour): it is
+    /// kept, and only a non-finite one is dropped.
+    #[test]
+    fn signed_samples_keep_negative_channels() {
+        let mut p = PixelSums::EMPTY;
+        for v in [1.0, -0.25, f32::NAN, 0.5] {
+            p.add(&PathSample {
+                signed: true,
+                ..sample(v)
+            });
+        }
+        assert_eq!((p.n, p.dropped), (3, 1));
+        assert!((p.mean()[0] - 1.25 / 3.0).abs() < 1e-6);
     }
 }

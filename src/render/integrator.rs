@@ -54,7 +54,8 @@ use super::manifold::{Chain, WalkNumbers, WalkVertex};
 use super::path::{ManifoldVertex, PathSample, PathState};
 use super::shading::shade;
 use super::world::{Hit, LightRef, World};
-use crate::bsdf::{Bsdf, Bxdf};
+use crate::bsdf::{Bsdf, Scatter};
+use crate::color::Rgb;
 use crate::geometry::ray::OFFSET_SCALE;
 use crate::geometry::{MediumId, Ray, offset_origin};
 use crate::medium::FreeFlight;
@@ -76,22 +77,42 @@ const RR_DEPTH: u32 = 3;
 /// * `strategy` – direct-light estimators.
 pub fn trace<S: Spectral>(
     world: &World,
-    mut ray: Ray,
+    ray: Ray,
     sampler: &mut PixelSampler,
     max_depth: u32,
     strategy: Strategy,
 ) -> PathSample
 where
-    Bsdf: Bxdf<S>,
+    Bsdf: Scatter<S>,
 {
-    let mut out = PathSample {
-        material: -2,
-        ..PathSample::default()
-    };
     let lambda = if S::WAVELENGTH_DIMENSIONS > 0 {
         S::sample_wavelengths(sampler.get2d_at(slots::WAVELENGTH).x)
     } else {
         S::sample_wavelengths(0.0)
+    };
+    trace_at::<S>(world, ray, sampler, max_depth, strategy, lambda).0
+}
+
+/// [`trace`] at given wavelengths: the film sample and the path's estimate at each wavelength
+/// (for tests that hold the wavelengths fixed, e.g. a furnace at every wavelength). After a
+/// dispersive refraction only channel 0 (the hero) of the estimate is meaningful.
+///
+/// # Arguments
+/// As [`trace`], and `lambda` – the wavelengths the path carries.
+pub fn trace_at<S: Spectral>(
+    world: &World,
+    mut ray: Ray,
+    sampler: &mut PixelSampler,
+    max_depth: u32,
+    strategy: Strategy,
+    lambda: S::Wavelengths,
+) -> (PathSample, S)
+where
+    Bsdf: Scatter<S>,
+{
+    let mut out = PathSample {
+        material: -2,
+        ..PathSample::default()
     };
     if world.camera_medium != MediumId::OUTSIDE {
         ray.medium = world.camera_medium;
@@ -204,7 +225,7 @@ where
         }
         let hit = match found {
             None => {
-                let le = S::from_unbounded(world.environment.radiance(ray.dir), &path.lambda);
+                let le = S::from_illuminant(world.environment.radiance(ray.dir), &path.lambda);
                 let w = emission_weight(world, strategy, &path, || {
                     (LightRef::Environment, world.environment.pdf(ray.dir))
                 });
@@ -212,7 +233,7 @@ where
                 break;
             }
             Some(Hit::Light { index, t }) => {
-                let le = S::from_unbounded(world.areas[index].emitted(-ray.dir), &path.lambda);
+                let le = S::from_illuminant(world.areas[index].emitted(-ray.dir), &path.lambda);
                 let w = match (path.manifold, &world.manifold) {
                     // The walk's chain of refractions since a vertex where the walk ran.
                     (Some(v), Some(setup)) if v.crossings == v.chain.crossings() => {
@@ -312,8 +333,8 @@ where
             && let Some(ml) = manifold::sample_light::<S>(world, setup, v, u, &path.lambda)
             && sb.admits(ml.d)
         {
-            let (wi_local, f) = sb.eval::<S>(wo_local, ml.d);
-            let p_bsdf = sb.pdf::<S>(wo_local, wi_local) * ml.cross;
+            let (wi_local, f) = sb.eval::<S>(wo_local, ml.d, &path.lambda);
+            let p_bsdf = sb.pdf::<S>(wo_local, wi_local, &path.lambda) * ml.cross;
             let w = manifold_weight(strategy, ml.pdf, p_bsdf, true);
             let c = path.throughput() * f * ml.value * (wi_local.z.abs() * w);
             if c.is_valid() {
@@ -325,7 +346,7 @@ where
         // Continue the path by sampling the BSDF.
         let uc = sampler.get1d();
         let u = sampler.get2d();
-        let Some(bs) = sb.sample::<S>(wo_local, uc, u) else {
+        let Some(bs) = sb.sample::<S>(wo_local, uc, u, &path.lambda) else {
             break;
         };
         if world.transmission_off && bs.flags.is_transmission() {
@@ -357,6 +378,10 @@ where
             }
             _ => None,
         };
+        if bs.terminate_secondary {
+            // A dispersive refraction sent each wavelength its own way: only the hero goes on.
+            S::terminate_secondary(&mut path.lambda);
+        }
         path.scatter(&bs, sb.p, sb.inside);
         path.platelet = match hit {
             Hit::Platelet { id, .. } => Some(id),
@@ -388,8 +413,19 @@ where
         };
         ray = Ray::in_medium(origin, bs.wi, path.medium);
     }
-    out.radiance = path.l.to_rgb(&path.lambda);
-    out
+    if S::WAVELENGTH_DIMENSIONS > 0 {
+        // Spectral: XYZ is a non-negative combination of the wavelengths' values, Rec.709 a
+        // linear map of it that may leave the gamut (crate::spectrum::hero).
+        out.signed = true;
+        out.radiance = if path.l.is_valid() {
+            path.l.to_rgb(&path.lambda)
+        } else {
+            Rgb::splat(f32::NAN)
+        };
+    } else {
+        out.radiance = path.l.to_rgb(&path.lambda);
+    }
+    (out, path.l)
 }
 
 /// A medium scattering point `p` on `ray`, moved off the surface hit the ray was heading for

@@ -28,15 +28,16 @@ pub use camera::CameraRays;
 pub use direct::Strategy;
 pub use film::{Film, PixelSums};
 pub use filter::FilterSampler;
-pub use integrator::trace;
+pub use integrator::{trace, trace_at};
 pub use output::{Metadata, exr_image};
 pub use path::{PathSample, PathState};
 pub use shading::{ShadingContext, SurfaceBsdf};
 pub use world::{World, WorldError};
 
+use crate::bsdf::{Bsdf, Scatter};
 use crate::sampler::PixelSampler;
 use crate::scene::stage::{Camera, RenderSettings};
-use crate::spectrum::RgbSample;
+use crate::spectrum::{HeroSample, RgbSample, Spectral};
 use glam::Vec2;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -114,7 +115,15 @@ pub fn render(
     control: &Control,
 ) -> Rendered {
     let start = Instant::now();
-    let run = || render_passes(world, camera, depth_of_field, settings, control);
+    // The transported-light variant is chosen once per render: each is its own monomorphised
+    // renderer (crate::spectrum docs), so an RGB render runs no spectral code at all.
+    let run = || {
+        if world.spectral {
+            render_passes::<HeroSample>(world, camera, depth_of_field, settings, control)
+        } else {
+            render_passes::<RgbSample>(world, camera, depth_of_field, settings, control)
+        }
+    };
     let (film, partial, spp_complete) = match control.threads {
         Some(n) => match rayon::ThreadPoolBuilder::new()
             .num_threads(n.max(1))
@@ -151,13 +160,16 @@ pub fn render_scene(world: &World, scene: &crate::scene::Scene, control: &Contro
     )
 }
 
-fn render_passes(
+fn render_passes<S: Spectral>(
     world: &World,
     camera: &Camera,
     depth_of_field: bool,
     settings: &RenderSettings,
     control: &Control,
-) -> (Film, bool, u32) {
+) -> (Film, bool, u32)
+where
+    Bsdf: Scatter<S>,
+{
     let (w, h) = (settings.width, settings.height);
     let mut film = Film::new(w, h);
     let rays = CameraRays::new(camera, w, h, depth_of_field);
@@ -193,7 +205,7 @@ fn render_passes(
                             let lens = sampler.get2d();
                             let film_pt = Vec2::new(x as f32 + 0.5, y as f32 + 0.5) + offset;
                             let ray = rays.ray(film_pt, lens);
-                            let sample = trace::<RgbSample>(
+                            let sample = trace::<S>(
                                 world,
                                 ray,
                                 &mut sampler,

@@ -10,8 +10,13 @@ use glam::Vec3;
 /// Radiance and first-hit data of one camera path.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct PathSample {
-    /// Radiance along the camera ray, as the film stores it.
+    /// Radiance along the camera ray, as the film stores it (linear Rec.709).
     pub radiance: Rgb,
+    /// True when `radiance` is the Rec.709 image of a spectral estimate's CIE XYZ (a linear map of
+    /// a non-negative XYZ): one sample of a saturated colour may then have a negative channel,
+    /// which the film keeps (the mean is the image of the mean XYZ). A spectral estimate that is
+    /// not finite and non-negative at every wavelength has a NaN `radiance` and is dropped.
+    pub signed: bool,
     /// Albedo at the first hit (0 where the ray leaves the scene or meets a light).
     pub albedo: Rgb,
     /// World shading normal at the first hit (facet normal on glitter), 0 if none.

@@ -5,7 +5,7 @@
 
 use super::path::PathSample;
 use super::world::{Hit, World};
-use crate::bsdf::{Bsdf, BsdfSample, Bxdf, LobeFlags, TransportMode};
+use crate::bsdf::{Bsdf, BsdfSample, Bxdf, LobeFlags, Scatter, TransportMode};
 use crate::geometry::{Frame, MediumId};
 use crate::spectrum::Spectral;
 use crate::texture::bump::facet_frame;
@@ -69,37 +69,43 @@ impl<'a> SurfaceBsdf<'a> {
 
     /// `f(wo, wi)` for world directions, sr⁻¹.
     #[inline]
-    pub fn eval<S: Spectral>(&self, wo_local: Vec3, wi: Vec3) -> (Vec3, S)
+    pub fn eval<S: Spectral>(&self, wo_local: Vec3, wi: Vec3, lambda: &S::Wavelengths) -> (Vec3, S)
     where
-        Bsdf: Bxdf<S>,
+        Bsdf: Scatter<S>,
     {
         let wi_local = self.frame.to_local(wi);
         (
             wi_local,
             self.bxdf
-                .eval_mode(wo_local, wi_local, TransportMode::Radiance),
+                .eval_at(wo_local, wi_local, TransportMode::Radiance, lambda),
         )
     }
 
     /// Density of `wi_local` (local frame) from `wo_local`.
     #[inline]
-    pub fn pdf<S: Spectral>(&self, wo_local: Vec3, wi_local: Vec3) -> f32
+    pub fn pdf<S: Spectral>(&self, wo_local: Vec3, wi_local: Vec3, lambda: &S::Wavelengths) -> f32
     where
-        Bsdf: Bxdf<S>,
+        Bsdf: Scatter<S>,
     {
-        <Bsdf as Bxdf<S>>::pdf(self.bxdf, wo_local, wi_local)
+        <Bsdf as Scatter<S>>::pdf_at(self.bxdf, wo_local, wi_local, lambda)
     }
 
     /// Samples a direction in radiance mode; the sample's `wi` is returned in world space (unit
     /// length) and `None` unless the surface admits it.
     #[inline]
-    pub fn sample<S: Spectral>(&self, wo_local: Vec3, uc: f32, u: Vec2) -> Option<BsdfSample<S>>
+    pub fn sample<S: Spectral>(
+        &self,
+        wo_local: Vec3,
+        uc: f32,
+        u: Vec2,
+        lambda: &S::Wavelengths,
+    ) -> Option<BsdfSample<S>>
     where
-        Bsdf: Bxdf<S>,
+        Bsdf: Scatter<S>,
     {
         let mut bs = self
             .bxdf
-            .sample_mode(wo_local, uc, u, TransportMode::Radiance)?;
+            .sample_at(wo_local, uc, u, TransportMode::Radiance, lambda)?;
         bs.wi = self.frame.to_world(bs.wi).normalize();
         self.admits(bs.wi).then_some(bs)
     }

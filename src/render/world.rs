@@ -113,6 +113,9 @@ pub struct World {
     pub map: Map,
     /// Whether facet bumps apply.
     pub facet_bump: bool,
+    /// Whether paths carry wavelengths (the `spectral` effect): [`super::render`] then traces
+    /// [`crate::spectrum::HeroSample`] instead of RGB.
+    pub spectral: bool,
     /// Centre and radius of a sphere bounding the stone, the floor patch under it and the lights.
     pub bounds: (Vec3, f32),
 }
@@ -325,14 +328,20 @@ impl World {
             })
             .collect();
 
+        // The walks solve Snell's law with one index: a dispersive body in a spectral render
+        // refracts each wavelength its own way, so there light is found by BSDF sampling alone.
+        let dispersive =
+            scene.effects.on(Effect::Spectral) && body.is_some_and(|b| b.dispersion.is_some());
         let manifold = match body {
-            Some(b) if shows_body && b.alpha == 0.0 => super::manifold::ManifoldSetup::new(
-                b.ior,
-                scene.surface.body_index(),
-                &areas,
-                scene.effects.on(Effect::ManifoldNee),
-                scene.effects.on(Effect::ManifoldCaustics),
-            ),
+            Some(b) if shows_body && b.alpha == 0.0 && !dispersive => {
+                super::manifold::ManifoldSetup::new(
+                    b.ior,
+                    scene.surface.body_index(),
+                    &areas,
+                    scene.effects.on(Effect::ManifoldNee),
+                    scene.effects.on(Effect::ManifoldCaustics),
+                )
+            }
             _ => None,
         };
         let platelets = match body {
@@ -385,6 +394,7 @@ impl World {
                 bump: scene.effects.forced(Effect::FacetBump) != Some(false),
             }),
             facet_bump: scene.effects.on(Effect::FacetBump),
+            spectral: scene.effects.on(Effect::Spectral),
             bounds: (centre, radius),
         })
     }

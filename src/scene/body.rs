@@ -1,6 +1,7 @@
 //! A translucent stone's compiled body (issue 17): the boundary interface and the interior
 //! medium, in **object units** (the world converts the coefficients with the stage's scale).
 
+use crate::bsdf::dispersion::{Dispersion, Ior};
 use crate::bsdf::{Bsdf, Distribution, Masking, MicrofacetDistribution, RoughDielectric};
 use crate::bsdf::{SmoothDielectric, StackDesc};
 use crate::color::Rgb;
@@ -16,8 +17,11 @@ pub const BOUNDARY_GRID: usize = 64;
 /// The body of a translucent stone.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Body {
-    /// Absolute IOR of the stone (the outside is air, IOR 1).
+    /// Absolute IOR of the stone (the outside is air, IOR 1); for a dispersive body its index at
+    /// the d line (587.56 nm), which RGB paths use.
     pub ior: f32,
+    /// The index as a function of the wavelength, for spectral paths (`None`: not dispersive).
+    pub dispersion: Option<Ior>,
     /// Boundary roughness `α` (0: a smooth, specular boundary).
     pub alpha: f32,
     /// Micro-facet distribution of a rough boundary.
@@ -50,12 +54,25 @@ impl Body {
     /// reciprocal multiple-scattering compensation (`bsdf::interface_energy`), so a lossless body
     /// keeps all the energy that enters it. `eta` is inside over outside.
     pub fn boundary(&self) -> Bsdf {
+        let law = self.dispersion.map(|inside| Dispersion {
+            inside,
+            outside: 1.0,
+        });
         if self.alpha == 0.0 {
-            Bsdf::SmoothDielectric(SmoothDielectric::new(self.ior))
+            let b = SmoothDielectric::new(self.ior);
+            Bsdf::SmoothDielectric(match law {
+                Some(l) => SmoothDielectric {
+                    dispersion: Some(l),
+                    ..b
+                },
+                None => b,
+            })
         } else {
             let d = MicrofacetDistribution::from_alpha(self.distribution, self.alpha)
                 .with_masking(self.masking);
-            Bsdf::Dielectric(RoughDielectric::new(d, self.ior).with_energy_tables_at(BOUNDARY_GRID))
+            let mut b = RoughDielectric::new(d, self.ior).with_energy_tables_at(BOUNDARY_GRID);
+            b.dispersion = law;
+            Bsdf::Dielectric(b)
         }
     }
 

@@ -20,7 +20,8 @@ pub enum Effect {
     StochasticSwitch,
     /// Light transmitted into a translucent body (refraction in and out, total internal reflection).
     Transmission,
-    /// Spectral rendering (later work; colours are RGB today).
+    /// Spectral transport: four wavelengths per path (hero-wavelength sampling), measured spectra,
+    /// spectral metals, dispersion (issue 19).
     Spectral,
     /// Fluorescence, course §5.2.2 (later work).
     Fluorescence,
@@ -82,7 +83,7 @@ impl Effect {
     /// Whether this version can simulate the effect at all (the others are slots for later work:
     /// no recipe element turns them on yet).
     pub fn implemented(self) -> bool {
-        !matches!(self, Effect::Spectral | Effect::Fluorescence)
+        !matches!(self, Effect::Fluorescence)
     }
 
     /// What turns the effect on.
@@ -106,7 +107,9 @@ impl Effect {
             Effect::ManifoldCaustics => {
                 "a smooth `body` boundary on a stage with a floor, under an area light"
             }
-            Effect::Spectral => "spectral colours",
+            Effect::Spectral => {
+                "a dispersive `body` IOR (Cauchy, Sellmeier or Abbe number), or `--spectral`"
+            }
             Effect::Fluorescence => "a fluorescent material",
             Effect::DepthOfField => "a perspective camera with aperture > 0",
             Effect::EnvironmentImportance => "an environment Map (EXR)",

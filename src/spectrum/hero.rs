@@ -129,7 +129,9 @@ impl Spectral for HeroSample {
 
     fn from_illuminant(c: Rgb, lambda: &HeroWavelengths) -> Self {
         let (scale, s) = rgb2spec::illuminant(c.0);
-        HeroSample::at(lambda, |l| scale * s.eval(l) * rgb2spec::d65_normalised(l))
+        HeroSample(std::array::from_fn(|i| {
+            scale * s.eval(lambda.lambda[i]) * lambda.illuminant[i]
+        }))
     }
 
     fn to_rgb(self, lambda: &HeroWavelengths) -> Rgb {

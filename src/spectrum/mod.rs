@@ -23,6 +23,7 @@
 //! dispatch or a widest-case layout on every multiply of the hot path. The cost is compile time and
 //! code size for each variant, paid only by the variants the binary instantiates.
 
+pub mod basis;
 pub mod cie;
 pub mod hero;
 pub mod rgb;

@@ -121,6 +121,39 @@ pub fn reflectance(rgb: [f32; 3]) -> Sigmoid {
     if rgb[0] == rgb[1] && rgb[1] == rgb[2] {
         return Sigmoid::flat(rgb[0]);
     }
+    // A renderer asks for the same few colours (a light's, an albedo, a medium's coefficients)
+    // again and again: a small per-thread memo saves the table's eight scattered reads (the
+    // table is 1.2 MB, beyond the core's cache). The key is the colour's bits, so a hit returns
+    // exactly what the lookup would.
+    let key = rgb.map(f32::to_bits);
+    let slot = (key[0]
+        .wrapping_mul(0x9e37_79b9)
+        .wrapping_add(key[1].wrapping_mul(0x85eb_ca6b))
+        .wrapping_add(key[2].wrapping_mul(0xc2b2_ae35))
+        >> (32 - MEMO_BITS)) as usize;
+    if let Some(s) = MEMO.with(|m| {
+        let (k, s) = m.borrow()[slot];
+        (k == key).then_some(s)
+    }) {
+        return s;
+    }
+    let s = lookup(rgb);
+    MEMO.with(|m| m.borrow_mut()[slot] = (key, s));
+    s
+}
+
+/// log2 of the per-thread memo's entries.
+const MEMO_BITS: u32 = 6;
+
+thread_local! {
+    /// Recent colours and their spectra, direct-mapped by a hash of the colour's bits (the key
+    /// `[u32::MAX; 3]` is a NaN colour, which [`unit`] never produces, so empty slots never hit).
+    static MEMO: std::cell::RefCell<[([u32; 3], Sigmoid); 1 << MEMO_BITS]> =
+        const { std::cell::RefCell::new([([u32::MAX; 3], Sigmoid::ZERO); 1 << MEMO_BITS]) };
+}
+
+/// [`reflectance`] without the memo, for a non-grey colour in `[0, 1]³`.
+fn lookup(rgb: [f32; 3]) -> Sigmoid {
     let l = if rgb[0] >= rgb[1] && rgb[0] >= rgb[2] {
         0
     } else if rgb[1] >= rgb[2] {

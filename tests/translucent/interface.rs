@@ -52,6 +52,7 @@ fn interfaces() -> Vec<(String, RoughDielectric, RoughDielectric)> {
         for (name, alpha) in [("m 10°", 10f32.to_radians().tan()), ("α 0.5", 0.5)] {
             let body = Body {
                 ior: eta,
+                dispersion: None,
                 alpha,
                 distribution: Distribution::Ggx,
                 masking: Masking::Smith,

@@ -26,7 +26,7 @@ pub mod reference;
 
 use super::table::Table;
 use super::{
-    Bsdf, BsdfSample, Bxdf, Distribution, Fresnel, FresnelMode, Lambert, LobeFlags, Masking,
+    Bsdf, BsdfSample, Bxdf, Distribution, Fresnel, FresnelMode, Lambert, LobeFlags, Masking, Metal,
     MicrofacetDistribution, OrenNayar, RoughDielectric, TorranceSparrow, TransportMode,
 };
 use crate::color::Rgb;
@@ -61,6 +61,20 @@ pub enum ConductorIor {
     },
     /// Reflectance 1 at every angle (a perfect mirror; for furnace tests).
     Perfect,
+    /// A measured metal: RGB paths use its preset `n + i k` ([`Metal::nk`]), spectral paths its
+    /// tables at each wavelength ([`Metal::nk_at`]).
+    Measured(Metal),
+}
+
+impl ConductorIor {
+    /// `(n, k)` per RGB channel, `None` for the perfect mirror.
+    pub fn rgb(&self) -> Option<(Rgb, Rgb)> {
+        match *self {
+            ConductorIor::Complex { n, k } => Some((n, k)),
+            ConductorIor::Measured(m) => Some(m.nk()),
+            ConductorIor::Perfect => None,
+        }
+    }
 }
 
 /// The opaque base of a stack.
@@ -345,19 +359,24 @@ impl LayeredBsdf {
                 sigma,
             }),
             Base::Conductor { ior, roughness } => {
-                let fresnel = match ior {
-                    ConductorIor::Perfect => Fresnel::Perfect,
-                    ConductorIor::Complex { n, k } => Fresnel::conductor(
+                let fresnel = match ior.rgb() {
+                    None => Fresnel::Perfect,
+                    Some((n, k)) => Fresnel::conductor(
                         RgbSample::from(n) / above,
                         RgbSample::from(k) / above,
                         desc.fresnel,
                     ),
                 };
-                Bsdf::TorranceSparrow(TorranceSparrow::new(
+                let mut lobe = TorranceSparrow::new(
                     MicrofacetDistribution::new(desc.distribution, roughness)
                         .with_masking(desc.masking),
                     fresnel,
-                ))
+                );
+                if let ConductorIor::Measured(metal) = ior {
+                    lobe.metal =
+                        Some(super::torrance_sparrow::SpectralMetal { metal, host: above });
+                }
+                Bsdf::TorranceSparrow(lobe)
             }
         };
         let base_plain = base.clone();
@@ -549,7 +568,7 @@ pub fn validate(desc: &StackDesc) -> Result<(), StackError> {
             if !(0.01..90.0).contains(&roughness) {
                 return bad("base.roughness".into(), roughness, "0.01 ..< 90 degrees");
             }
-            if let ConductorIor::Complex { n, k } = ior {
+            if let Some((n, k)) = ior.rgb() {
                 for ch in 0..3 {
                     if !(n[ch] > 0.0 && n[ch] <= 20.0) {
                         return bad(format!("base.n[{ch}]"), n[ch], "0 <.. 20");

@@ -98,6 +98,7 @@ pub fn sample(
         // The walk's density has no closed form: `pdf` is the mixture approximation of
         // [`pdf`], proportional in spirit only.
         pdf_is_proportional: true,
+        terminate_secondary: false,
     })
 }
 

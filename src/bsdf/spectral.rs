@@ -1,0 +1,425 @@
+//! Scattering at a path's wavelengths: the interface the integrator calls ([`Scatter`]), for
+//! the RGB variant (the [`Bxdf`] models as they are) and the spectral one ([`HeroSample`]).
+//!
+//! Each model at four wavelengths `λ_i` (issue 19; docs/spectral.md):
+//!
+//! - **Lambert, Oren–Nayar** — the albedo as a smooth reflectance spectrum (Jakob & Hanika 2019,
+//!   [`Spectral::from_reflectance`]), the model applied at each wavelength (Oren–Nayar's
+//!   interreflection term is quadratic in the albedo, so this is not the RGB value upsampled).
+//! - **Torrance–Sparrow** — the geometry is colourless; the facet's Fresnel factor of a measured
+//!   metal is the exact conductor formula with the tabulated `(n + i k)(λ) / host`
+//!   ([`super::Metal::nk_at`]); any other Fresnel factor is the RGB one as a reflectance spectrum
+//!   (not `n` and `k` upsampled separately, which gives wrong colours: mitsuba3 #208). The
+//!   multiple-scattering compensation (Turquin 2019) uses the same `F0(λ)`.
+//! - **Dielectric interfaces** — colourless, unless dispersive ([`super::dispersion`]): a smooth
+//!   interface reflects all four wavelengths (each with its own Fresnel factor, weighted against
+//!   the hero's choice probability) and refracts only the hero (the path terminates its secondary
+//!   wavelengths, pbrt-v4 §4.5.4); a rough interface samples with the hero's index and keeps all
+//!   four, each weighted by its own `f(λ_i)` over the hero's density.
+//! - **Layer stacks** — a stack without coats is its base (so bare metal flakes and platelets are
+//!   spectral metals); a coated stack is evaluated by its RGB model and its value taken as an
+//!   spectrum by the linear map of [`crate::spectrum::basis`] (Smits' construction over
+//!   Jakob–Hanika basis spectra): the stack's tables (energy, calibration, multiple-reflection
+//!   lobe) are built per RGB channel, so the spectrum of a coated stack is a spectrum of its RGB
+//!   value, not the stack of its parameters' spectra (docs/spectral.md states what this costs in
+//!   colour).
+
+use super::dispersion::Dispersion;
+use super::layered::Model;
+use super::{
+    Bsdf, BsdfSample, Bxdf, Lambert, Lobe, LobeKind, OrenNayar, RoughDielectric, SmoothDielectric,
+    TorranceSparrow, TransportMode, flush_tiny, fresnel, refract,
+};
+use crate::color::Rgb;
+use crate::spectrum::wavelengths::HeroWavelengths;
+use crate::spectrum::{HeroSample, RgbSample, RgbWavelengths, Spectral, basis};
+use glam::{Vec2, Vec3};
+use std::f32::consts::FRAC_1_PI;
+
+/// A scattering model evaluated at the wavelengths a path carries: what the integrator calls.
+/// The RGB variant ignores the (zero-sized) wavelengths and is the [`Bxdf`] model itself, bit for
+/// bit; the spectral variant is this module's.
+pub trait Scatter<S: Spectral> {
+    /// `f(wo, wi)` at the path's wavelengths, sr⁻¹, cosine excluded ([`Bxdf::eval_mode`]).
+    fn eval_at(&self, wo: Vec3, wi: Vec3, mode: TransportMode, lambda: &S::Wavelengths) -> S;
+    /// Samples `wi` ([`Bxdf::sample_mode`]); a sample with
+    /// [`BsdfSample::terminate_secondary`] asks the path to keep only its hero wavelength.
+    fn sample_at(
+        &self,
+        wo: Vec3,
+        uc: f32,
+        u: Vec2,
+        mode: TransportMode,
+        lambda: &S::Wavelengths,
+    ) -> Option<BsdfSample<S>>;
+    /// Density of `wi` from `wo` ([`Bxdf::pdf`]), for the hero wavelength's sampling.
+    fn pdf_at(&self, wo: Vec3, wi: Vec3, lambda: &S::Wavelengths) -> f32;
+}
+
+impl Scatter<RgbSample> for Bsdf {
+    #[inline]
+    fn eval_at(&self, wo: Vec3, wi: Vec3, mode: TransportMode, _: &RgbWavelengths) -> RgbSample {
+        self.eval_mode(wo, wi, mode)
+    }
+    #[inline]
+    fn sample_at(
+        &self,
+        wo: Vec3,
+        uc: f32,
+        u: Vec2,
+        mode: TransportMode,
+        _: &RgbWavelengths,
+    ) -> Option<BsdfSample> {
+        self.sample_mode(wo, uc, u, mode)
+    }
+    #[inline]
+    fn pdf_at(&self, wo: Vec3, wi: Vec3, _: &RgbWavelengths) -> f32 {
+        Bxdf::<RgbSample>::pdf(self, wo, wi)
+    }
+}
+
+impl Scatter<HeroSample> for Bsdf {
+    fn eval_at(
+        &self,
+        wo: Vec3,
+        wi: Vec3,
+        mode: TransportMode,
+        lambda: &HeroWavelengths,
+    ) -> HeroSample {
+        match self {
+            Bsdf::Lambert(b) => lambert(b, wo, wi, lambda),
+            Bsdf::OrenNayar(b) => oren_nayar(b, wo, wi, lambda),
+            Bsdf::TorranceSparrow(b) => torrance_sparrow(b, wo, wi, lambda),
+            Bsdf::Dielectric(b) => match b.dispersion {
+                None => HeroSample::splat(b.value(wo, wi, mode)),
+                Some(law) => rough_dispersive(b, law, wo, wi, mode, lambda),
+            },
+            Bsdf::SmoothDielectric(_) => HeroSample::ZERO,
+            Bsdf::Layered(b) => match bare_base(b) {
+                Some(base) => base.eval_at(wo, wi, mode, lambda),
+                None => upsample(b.eval_mode(wo, wi, mode), lambda),
+            },
+        }
+    }
+
+    fn sample_at(
+        &self,
+        wo: Vec3,
+        uc: f32,
+        u: Vec2,
+        mode: TransportMode,
+        lambda: &HeroWavelengths,
+    ) -> Option<BsdfSample<HeroSample>> {
+        match self {
+            Bsdf::SmoothDielectric(b) => match b.dispersion {
+                None => grey(b.sample_mode(wo, uc, u, mode)?),
+                Some(law) => smooth_dispersive(b, law, wo, uc, mode, lambda),
+            },
+            Bsdf::Dielectric(b) => match b.dispersion {
+                None => grey(b.sample_mode(wo, uc, u, mode)?),
+                Some(law) => {
+                    let hero = at_eta(b, law.eta_at(lambda.lambda[0]));
+                    let s = hero.sample_mode(wo, uc, u, mode)?;
+                    let f = rough_dispersive(b, law, wo, s.wi, mode, lambda);
+                    recolour(s, f)
+                }
+            },
+            Bsdf::Layered(b) => match bare_base(b) {
+                Some(base) => base.sample_at(wo, uc, u, mode, lambda),
+                None => {
+                    let s = b.sample_mode(wo, uc, u, mode)?;
+                    let f = upsample(s.f, lambda);
+                    // `weight = f |cos θi| / pdf` (BsdfSample::from_eval), except for the
+                    // Reference walk's unbiased weight.
+                    let weight = if s.pdf_is_proportional {
+                        upsample(s.weight, lambda)
+                    } else {
+                        f * (s.wi.z.abs() / s.pdf)
+                    };
+                    Some(BsdfSample {
+                        f,
+                        weight,
+                        ..relabel(s)
+                    })
+                }
+            },
+            // The remaining models sample without regard to colour: the RGB sample's direction
+            // and density, the value at the wavelengths.
+            _ => {
+                let s = self.sample_mode(wo, uc, u, mode)?;
+                let f = self.eval_at(wo, s.wi, mode, lambda);
+                recolour(s, f)
+            }
+        }
+    }
+
+    fn pdf_at(&self, wo: Vec3, wi: Vec3, lambda: &HeroWavelengths) -> f32 {
+        match self {
+            Bsdf::Dielectric(b) => match b.dispersion {
+                None => b.pdf(wo, wi),
+                Some(law) => at_eta(b, law.eta_at(lambda.lambda[0])).pdf(wo, wi),
+            },
+            Bsdf::Layered(b) => match bare_base(b) {
+                Some(base) => Scatter::<HeroSample>::pdf_at(base, wo, wi, lambda),
+                None => b.pdf(wo, wi),
+            },
+            _ => Bxdf::<RgbSample>::pdf(self, wo, wi),
+        }
+    }
+}
+
+/// The base a coat-less stack evaluates to (the course's plain base for the Course model, the
+/// compensated one otherwise); `None` for a coated stack or the Reference walk.
+#[inline]
+fn bare_base(b: &super::LayeredBsdf) -> Option<&Bsdf> {
+    if b.coats() > 0 {
+        return None;
+    }
+    match b.model() {
+        Model::Course => Some(&b.base_plain),
+        Model::Corrected => Some(&b.base),
+        Model::Reference(_) => None,
+    }
+}
+
+/// A value the RGB model computed, as a spectrum at the wavelengths (the linear map of
+/// [`crate::spectrum::basis`]: a grey stays flat).
+#[inline]
+fn upsample(v: RgbSample, lambda: &HeroWavelengths) -> HeroSample {
+    HeroSample(basis::upsample(v.0, &lambda.lambda))
+}
+
+/// An RGB sample's record in the spectral type, with zero values (filled in by the caller).
+#[inline]
+fn relabel(s: BsdfSample) -> BsdfSample<HeroSample> {
+    BsdfSample {
+        wi: s.wi,
+        f: HeroSample::ZERO,
+        pdf: s.pdf,
+        weight: HeroSample::ZERO,
+        lobe: s.lobe,
+        flags: s.flags,
+        eta: s.eta,
+        pdf_is_proportional: s.pdf_is_proportional,
+        terminate_secondary: false,
+    }
+}
+
+/// A colourless sample (every channel equal) at every wavelength.
+#[inline]
+fn grey(s: BsdfSample) -> Option<BsdfSample<HeroSample>> {
+    Some(BsdfSample {
+        f: HeroSample::splat(s.f.0[0]),
+        weight: HeroSample::splat(s.weight.0[0]),
+        ..relabel(s)
+    })
+}
+
+/// An RGB sample's direction and density with the spectral value `f` at it.
+#[inline]
+fn recolour(s: BsdfSample, f: HeroSample) -> Option<BsdfSample<HeroSample>> {
+    let weight = f * (s.wi.z.abs() / s.pdf);
+    (f.is_valid() && weight.is_valid()).then(|| BsdfSample {
+        f,
+        weight,
+        ..relabel(s)
+    })
+}
+
+fn lambert(b: &Lambert, wo: Vec3, wi: Vec3, lambda: &HeroWavelengths) -> HeroSample {
+    if wo.z <= 0.0 || wi.z <= 0.0 {
+        return HeroSample::ZERO;
+    }
+    HeroSample::from_reflectance(Rgb::from(b.albedo), lambda) * FRAC_1_PI
+}
+
+fn oren_nayar(b: &OrenNayar, wo: Vec3, wi: Vec3, lambda: &HeroWavelengths) -> HeroSample {
+    if wo.z <= 0.0 || wi.z <= 0.0 {
+        return HeroSample::ZERO;
+    }
+    let (direct, inter) = b.factors(wo, wi);
+    let f = HeroSample::from_reflectance(Rgb::from(b.albedo), lambda)
+        .map(|r| (r * FRAC_1_PI * (direct + r * inter)).max(0.0));
+    if f.is_valid() { f } else { HeroSample::ZERO }
+}
+
+/// The facet reflectance of a Torrance–Sparrow lobe at `cos_i` and the wavelengths.
+#[inline]
+fn facet_fresnel(b: &TorranceSparrow, cos_i: f32, lambda: &HeroWavelengths) -> HeroSample {
+    match b.metal {
+        Some(m) => HeroSample::at(lambda, |l| {
+            let (n, k) = m.metal.nk_at(l);
+            fresnel::conductor(cos_i, n / m.host, k / m.host)
+        }),
+        None => {
+            let f = b.fresnel.eval(cos_i);
+            if f.0[0] == f.0[1] && f.0[1] == f.0[2] {
+                HeroSample::splat(f.0[0])
+            } else {
+                HeroSample::from_reflectance(Rgb::from(f), lambda)
+            }
+        }
+    }
+}
+
+fn torrance_sparrow(
+    b: &TorranceSparrow,
+    wo: Vec3,
+    wi: Vec3,
+    lambda: &HeroWavelengths,
+) -> HeroSample {
+    if wo.z <= 0.0 || wi.z <= 0.0 {
+        return HeroSample::ZERO;
+    }
+    let Some(h) = TorranceSparrow::half(wo, wi) else {
+        return HeroSample::ZERO;
+    };
+    if wo.dot(h) <= 0.0 || wi.dot(h) <= 0.0 {
+        return HeroSample::ZERO;
+    }
+    let d = b.distribution.d(h);
+    if d == 0.0 {
+        return HeroSample::ZERO;
+    }
+    let g = b.distribution.g(wo, wi, h);
+    let v = facet_fresnel(b, wi.dot(h).max(0.0), lambda) * (d * g / (4.0 * wo.z * wi.z));
+    flush_tiny(match &b.compensation {
+        None => v,
+        Some(c) => {
+            let e = c.e_ss.at(wo.z)[0].clamp(1e-3, 1.0);
+            v * (HeroSample::ONE + facet_fresnel(b, 1.0, lambda) * ((1.0 - e) / e))
+        }
+    })
+}
+
+/// The rough interface with relative index `eta` (its multiple-scattering lobe, built for the
+/// d line's index, kept: the lobe changes little over a dispersion of a few hundredths).
+#[inline]
+fn at_eta(b: &RoughDielectric, eta: f32) -> RoughDielectric {
+    RoughDielectric {
+        eta,
+        dispersion: None,
+        ..b.clone()
+    }
+}
+
+fn rough_dispersive(
+    b: &RoughDielectric,
+    law: Dispersion,
+    wo: Vec3,
+    wi: Vec3,
+    mode: TransportMode,
+    lambda: &HeroWavelengths,
+) -> HeroSample {
+    let mut d = at_eta(b, 1.0);
+    HeroSample(std::array::from_fn(|i| {
+        if lambda.pdf[i] == 0.0 {
+            return 0.0;
+        }
+        d.eta = law.eta_at(lambda.lambda[i]);
+        d.value(wo, wi, mode)
+    }))
+}
+
+/// A smooth dispersive interface: the hero's Fresnel factor picks reflection or refraction;
+/// a reflection keeps the four wavelengths (weights `F(λ_i)/F(λ_0)`), a refraction only the hero.
+fn smooth_dispersive(
+    b: &SmoothDielectric,
+    law: Dispersion,
+    wo: Vec3,
+    uc: f32,
+    mode: TransportMode,
+    lambda: &HeroWavelengths,
+) -> Option<BsdfSample<HeroSample>> {
+    if wo.z == 0.0 || !wo.is_finite() {
+        return None;
+    }
+    let eta: [f32; 4] = lambda.lambda.map(|l| law.eta_at(l));
+    let r0 = fresnel::dielectric(wo.z, eta[0]);
+    let t0 = 1.0 - r0;
+    let alive = |i: usize| lambda.pdf[i] > 0.0;
+    let (wi, value, prob, kind, etap, terminate) = if uc < r0 || t0 <= 0.0 {
+        let wi = Vec3::new(-wo.x, -wo.y, wo.z);
+        let value = HeroSample(std::array::from_fn(|i| {
+            if alive(i) {
+                fresnel::dielectric(wo.z, eta[i])
+            } else {
+                0.0
+            }
+        }));
+        (wi, value, r0, LobeKind::SpecularReflection, 1.0, false)
+    } else {
+        let wi = refract(wo, Vec3::Z, eta[0])?;
+        if wi.z * wo.z >= 0.0 {
+            return None;
+        }
+        let etap = if wo.z > 0.0 { eta[0] } else { 1.0 / eta[0] };
+        let ft = match mode {
+            TransportMode::Radiance => t0 / (etap * etap),
+            TransportMode::Importance => t0,
+        };
+        let mut value = HeroSample::ZERO;
+        value.0[0] = ft;
+        (wi, value, t0, LobeKind::SpecularTransmission, etap, true)
+    };
+    let cos = wi.z.abs();
+    if !(cos > 0.0 && prob > 0.0) {
+        return None;
+    }
+    let mut s = BsdfSample::from_eval(wi, value / cos, prob, Lobe { kind, layer: 0 })?;
+    s.eta = etap;
+    s.terminate_secondary = terminate && b.dispersion.is_some();
+    Some(s)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bsdf::dispersion::Ior;
+    use crate::bsdf::spherical_direction;
+
+    fn lambda(u: f32) -> HeroWavelengths {
+        HeroWavelengths::sample(u)
+    }
+
+    /// Greys and colourless models give the RGB value at every wavelength.
+    #[test]
+    fn colourless_models_match_rgb() {
+        let wo = spherical_direction(0.4, 0.2);
+        let wi = spherical_direction(0.9, 2.5);
+        let l = lambda(0.3);
+        let grey = Bsdf::Lambert(Lambert {
+            albedo: RgbSample::splat(0.5),
+        });
+        let v: HeroSample = grey.eval_at(wo, wi, TransportMode::Radiance, &l);
+        let rgb = grey.eval(wo, wi).0[0];
+        assert!(v.0.iter().all(|&x| (x - rgb).abs() < 1e-6), "{v:?} {rgb}");
+    }
+
+    /// A dispersive smooth interface refracts the hero by Snell's law with `n(λ_0)` and ends the
+    /// secondaries; a reflection keeps them.
+    #[test]
+    fn smooth_dispersion_refracts_the_hero() {
+        let law = Dispersion {
+            inside: Ior::from_abbe(1.7, 20.0).unwrap(),
+            outside: 1.0,
+        };
+        let b = Bsdf::SmoothDielectric(SmoothDielectric::new(1.7).with_dispersion(law));
+        let wo = spherical_direction(0.7, 0.0);
+        for u in [0.05f32, 0.3, 0.6, 0.95] {
+            let l = lambda(u);
+            let t: BsdfSample<HeroSample> = b
+                .sample_at(wo, 0.999, Vec2::ZERO, TransportMode::Radiance, &l)
+                .unwrap();
+            assert!(t.terminate_secondary && t.flags.is_transmission());
+            let n = law.eta_at(l.lambda[0]);
+            let (s_o, s_i) = (wo.truncate().length(), t.wi.truncate().length());
+            assert!((s_o - n * s_i).abs() < 1e-5, "Snell at {} nm", l.lambda[0]);
+            assert!(t.weight.0[1..].iter().all(|&w| w == 0.0));
+            let r: BsdfSample<HeroSample> = b
+                .sample_at(wo, 0.0, Vec2::ZERO, TransportMode::Radiance, &l)
+                .unwrap();
+            assert!(!r.terminate_secondary && r.weight.0.iter().all(|&w| w > 0.9 && w < 1.1));
+        }
+    }
+}
