@@ -28,7 +28,8 @@ use super::dispersion::Dispersion;
 use super::layered::Model;
 use super::{
     Bsdf, BsdfSample, Bxdf, Lambert, Lobe, LobeKind, OrenNayar, RoughDielectric, SmoothDielectric,
-    TorranceSparrow, TransportMode, flush_tiny, fresnel, refract,
+    TorranceSparrow, TransportMode, flush_tiny, fresnel, reflect, refract,
+    sample_cosine_hemisphere,
 };
 use crate::color::Rgb;
 use crate::spectrum::wavelengths::HeroWavelengths;
@@ -143,12 +144,37 @@ impl Scatter<HeroSample> for Bsdf {
                     })
                 }
             },
-            // The remaining models sample without regard to colour: the RGB sample's direction
-            // and density, the value at the wavelengths.
-            _ => {
-                let s = self.sample_mode(wo, uc, u, mode)?;
-                let f = self.eval_at(wo, s.wi, mode, lambda);
-                recolour(s, f)
+            // The reflecting models sample a direction without regard to colour (as their RGB
+            // `sample_mode` does, without evaluating RGB), then take the value at the wavelengths.
+            Bsdf::Lambert(_) | Bsdf::OrenNayar(_) => {
+                if wo.z <= 0.0 {
+                    return None;
+                }
+                let wi = sample_cosine_hemisphere(u)?;
+                let f = self.eval_at(wo, wi, mode, lambda);
+                diffuse(wi, f, Bxdf::<RgbSample>::pdf(self, wo, wi))
+            }
+            Bsdf::TorranceSparrow(b) => {
+                if wo.z <= 0.0 {
+                    return None;
+                }
+                let (h, _) = b.distribution.sample_visible(wo, uc, u)?;
+                if wo.dot(h) <= 0.0 {
+                    return None;
+                }
+                let wi = reflect(wo, h).normalize();
+                if wi.z <= 0.0 {
+                    return None;
+                }
+                BsdfSample::from_eval(
+                    wi,
+                    torrance_sparrow(b, wo, wi, lambda),
+                    b.pdf(wo, wi),
+                    Lobe {
+                        kind: LobeKind::Glossy,
+                        layer: 0,
+                    },
+                )
             }
         }
     }
@@ -215,6 +241,20 @@ fn grey(s: BsdfSample) -> Option<BsdfSample<HeroSample>> {
     })
 }
 
+/// A diffuse sample with the spectral value `f`.
+#[inline]
+fn diffuse(wi: Vec3, f: HeroSample, pdf: f32) -> Option<BsdfSample<HeroSample>> {
+    BsdfSample::from_eval(
+        wi,
+        f,
+        pdf,
+        Lobe {
+            kind: LobeKind::Diffuse,
+            layer: 0,
+        },
+    )
+}
+
 /// An RGB sample's direction and density with the spectral value `f` at it.
 #[inline]
 fn recolour(s: BsdfSample, f: HeroSample) -> Option<BsdfSample<HeroSample>> {
@@ -243,21 +283,47 @@ fn oren_nayar(b: &OrenNayar, wo: Vec3, wi: Vec3, lambda: &HeroWavelengths) -> He
     if f.is_valid() { f } else { HeroSample::ZERO }
 }
 
-/// The facet reflectance of a Torrance–Sparrow lobe at `cos_i` and the wavelengths.
+/// An RGB Fresnel factor as a reflectance spectrum (a grey stays flat).
 #[inline]
-fn facet_fresnel(b: &TorranceSparrow, cos_i: f32, lambda: &HeroWavelengths) -> HeroSample {
+fn reflectance(f: RgbSample, lambda: &HeroWavelengths) -> HeroSample {
+    if f.0[0] == f.0[1] && f.0[1] == f.0[2] {
+        HeroSample::splat(f.0[0])
+    } else {
+        HeroSample::from_reflectance(Rgb::from(f), lambda)
+    }
+}
+
+/// The facet reflectance of a Torrance–Sparrow lobe at `cos_i`, and its value at normal
+/// incidence when `with_f0` (for the compensation), at the wavelengths.
+#[inline]
+fn facet_fresnel(
+    b: &TorranceSparrow,
+    cos_i: f32,
+    with_f0: bool,
+    lambda: &HeroWavelengths,
+) -> (HeroSample, HeroSample) {
     match b.metal {
-        Some(m) => HeroSample::at(lambda, |l| {
-            let (n, k) = m.metal.nk_at(l);
-            fresnel::conductor(cos_i, n / m.host, k / m.host)
-        }),
-        None => {
-            let f = b.fresnel.eval(cos_i);
-            if f.0[0] == f.0[1] && f.0[1] == f.0[2] {
-                HeroSample::splat(f.0[0])
-            } else {
-                HeroSample::from_reflectance(Rgb::from(f), lambda)
+        Some(m) => {
+            let (mut f, mut f0) = (HeroSample::ZERO, HeroSample::ZERO);
+            for i in 0..4 {
+                let (n, k) = m.metal.nk_at(lambda.lambda[i]);
+                let (n, k) = (n / m.host, k / m.host);
+                f.0[i] = fresnel::conductor(cos_i, n, k);
+                if with_f0 {
+                    // Normal incidence in closed form: ((n − 1)² + k²) / ((n + 1)² + k²).
+                    f0.0[i] = ((n - 1.0) * (n - 1.0) + k * k) / ((n + 1.0) * (n + 1.0) + k * k);
+                }
             }
+            (f, f0)
+        }
+        None => {
+            let f = reflectance(b.fresnel.eval(cos_i), lambda);
+            let f0 = if with_f0 {
+                reflectance(b.fresnel.eval(1.0), lambda)
+            } else {
+                HeroSample::ZERO
+            };
+            (f, f0)
         }
     }
 }
@@ -282,12 +348,13 @@ fn torrance_sparrow(
         return HeroSample::ZERO;
     }
     let g = b.distribution.g(wo, wi, h);
-    let v = facet_fresnel(b, wi.dot(h).max(0.0), lambda) * (d * g / (4.0 * wo.z * wi.z));
+    let (f, f0) = facet_fresnel(b, wi.dot(h).max(0.0), b.compensation.is_some(), lambda);
+    let v = f * (d * g / (4.0 * wo.z * wi.z));
     flush_tiny(match &b.compensation {
         None => v,
         Some(c) => {
             let e = c.e_ss.at(wo.z)[0].clamp(1e-3, 1.0);
-            v * (HeroSample::ONE + facet_fresnel(b, 1.0, lambda) * ((1.0 - e) / e))
+            v * (HeroSample::ONE + f0 * ((1.0 - e) / e))
         }
     })
 }

@@ -159,12 +159,21 @@ pub fn describe(recipe: &GemRecipe, scene: &Scene, points: u32) -> String {
             ),
             _ => "clear".into(),
         };
+        let ior = match b.dispersion {
+            None => format!("{}", b.ior),
+            Some(law) => format!(
+                "{} (dispersive: n(486 nm) {:.4}, n(656 nm) {:.4}, Abbe {:.1})",
+                b.ior,
+                law.at(486.13),
+                law.at(656.27),
+                law.abbe()
+            ),
+        };
         let _ = writeln!(
             o,
-            "  {i:>3}  {:<width$}  {:>6.2}%  body: IOR {}, {boundary} boundary; interior {interior}",
+            "  {i:>3}  {:<width$}  {:>6.2}%  body: IOR {ior}, {boundary} boundary; interior {interior}",
             "Body",
             100.0 * f64::from(counts[i]) / f64::from(points),
-            b.ior
         );
         for (k, p) in b.platelets.iter().enumerate() {
             let orient = match p.orientation {

@@ -34,7 +34,7 @@ use std::time::{Duration, Instant};
 
 /// The settings studied when none are given: the recipe as written, then one knob changed at a
 /// time.
-pub const DEFAULT_SETTINGS: [&str; 13] = [
+pub const DEFAULT_SETTINGS: [&str; 15] = [
     "baseline",
     "model=course",
     "model=reference",
@@ -48,6 +48,9 @@ pub const DEFAULT_SETTINGS: [&str; 13] = [
     "max-depth=4",
     "max-depth=16",
     "model=course,fresnel=table",
+    // RGB against spectral transport: one of the two is the recipe's own variant.
+    "spectral=on",
+    "spectral=off",
 ];
 
 /// Arguments of `lapidary tradeoff`.

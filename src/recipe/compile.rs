@@ -380,8 +380,12 @@ impl Compiler<'_> {
     /// at least one emitting area light (the walk connects to points on lights) — from inside
     /// (`manifold-nee`) where the body holds platelets or a scattering medium (vertices inside
     /// that scatter light), through the stone (`manifold-caustics`) where a floor receives its
-    /// caustic.
+    /// caustic. Not for a dispersive body: the walks solve Snell's law with one index, and a
+    /// spectral path refracts each wavelength its own way (there light is found by BSDF sampling).
     fn manifold_effect(&mut self, body: &Body, stage: &crate::scene::stage::Stage) {
+        if body.dispersion.is_some() {
+            return;
+        }
         let r = self.recipe;
         let scatters_inside = !body.platelets.is_empty()
             || body.medium.is_some_and(|m| m.sigma_s.max_channel() > 0.0);

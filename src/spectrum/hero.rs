@@ -100,6 +100,59 @@ impl Div<f32> for HeroSample {
     }
 }
 
+/// Which conversion a memo entry holds.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Kind {
+    Reflectance = 1,
+    Unbounded = 2,
+    Illuminant = 3,
+}
+
+/// A memo entry's key: the conversion, the colour's bits and the four wavelengths' bits.
+type Key = [u32; 8];
+
+/// log2 of the per-thread memo's entries.
+const MEMO_BITS: u32 = 4;
+
+thread_local! {
+    /// Recent conversions at recent wavelengths, direct-mapped: a path meets the same light, sky,
+    /// medium and albedo colours at every vertex at its one set of wavelengths, and each
+    /// conversion is a table lookup and four sigmoid evaluations. The key holds every input bit,
+    /// so a hit returns exactly what the conversion would (an all-zero key is never made: the
+    /// kind is at least 1).
+    static MEMO: std::cell::RefCell<[(Key, HeroSample); 1 << MEMO_BITS]> =
+        const { std::cell::RefCell::new([([0; 8], HeroSample([0.0; N])); 1 << MEMO_BITS]) };
+}
+
+/// `compute()` through the memo.
+#[inline]
+fn memo(
+    kind: Kind,
+    c: Rgb,
+    lambda: &HeroWavelengths,
+    compute: impl FnOnce() -> HeroSample,
+) -> HeroSample {
+    let l = lambda.lambda.map(f32::to_bits);
+    let rgb = c.0.map(f32::to_bits);
+    let key: Key = [kind as u32, rgb[0], rgb[1], rgb[2], l[0], l[1], l[2], l[3]];
+    // The slot from the colour and the hero wavelength (the others follow from it for sampled
+    // wavelengths); the comparison below checks every word.
+    let h = (key[0] ^ key[1].wrapping_mul(0x9e37_79b9))
+        .wrapping_add(key[2].wrapping_mul(0x85eb_ca6b))
+        .wrapping_add(key[3].wrapping_mul(0xc2b2_ae35))
+        .wrapping_add(key[4].wrapping_mul(0x27d4_eb2f));
+    let slot = (h >> (32 - MEMO_BITS)) as usize;
+    if let Some(v) = MEMO.with(|m| {
+        let (k, v) = m.borrow()[slot];
+        (k == key).then_some(v)
+    }) {
+        return v;
+    }
+    let v = compute();
+    MEMO.with(|m| m.borrow_mut()[slot] = (key, v));
+    v
+}
+
 impl Spectral for HeroSample {
     type Wavelengths = HeroWavelengths;
     const WAVELENGTH_DIMENSIONS: u32 = 1;
@@ -118,20 +171,26 @@ impl Spectral for HeroSample {
     }
 
     fn from_reflectance(c: Rgb, lambda: &HeroWavelengths) -> Self {
-        let s = rgb2spec::reflectance(c.0);
-        HeroSample::at(lambda, |l| s.eval(l))
+        memo(Kind::Reflectance, c, lambda, || {
+            let s = rgb2spec::reflectance(c.0);
+            HeroSample::at(lambda, |l| s.eval(l))
+        })
     }
 
     fn from_unbounded(c: Rgb, lambda: &HeroWavelengths) -> Self {
-        let (scale, s) = rgb2spec::unbounded(c.0);
-        HeroSample::at(lambda, |l| scale * s.eval(l))
+        memo(Kind::Unbounded, c, lambda, || {
+            let (scale, s) = rgb2spec::unbounded(c.0);
+            HeroSample::at(lambda, |l| scale * s.eval(l))
+        })
     }
 
     fn from_illuminant(c: Rgb, lambda: &HeroWavelengths) -> Self {
-        let (scale, s) = rgb2spec::illuminant(c.0);
-        HeroSample(std::array::from_fn(|i| {
-            scale * s.eval(lambda.lambda[i]) * lambda.illuminant[i]
-        }))
+        memo(Kind::Illuminant, c, lambda, || {
+            let (scale, s) = rgb2spec::illuminant(c.0);
+            HeroSample(std::array::from_fn(|i| {
+                scale * s.eval(lambda.lambda[i]) * lambda.illuminant[i]
+            }))
+        })
     }
 
     fn to_rgb(self, lambda: &HeroWavelengths) -> Rgb {

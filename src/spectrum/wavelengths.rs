@@ -46,6 +46,35 @@ fn range() -> (f64, f64) {
     *RANGE
 }
 
+/// What [`HeroWavelengths::sample`] reads: the CDF's constants in `f32` and the unit-luminance
+/// D65 ([`super::rgb2spec::d65_normalised`]) at 1 nm, 360–830 nm (linear between its 1 nm
+/// values, as the CIE's 1 nm D65 is itself interpolated from 5 nm).
+struct Constants {
+    t0: f32,
+    span: f32,
+    /// `a / span`: the density is `(1 − y²) · a / span`.
+    pdf_scale: f32,
+    /// `1 / (2a)`: `λ = μ + ln((1 + y)/(1 − y)) / (2a)`.
+    half_inv_a: f32,
+    illuminant: Vec<f32>,
+}
+
+fn constants() -> &'static Constants {
+    static C: LazyLock<Constants> = LazyLock::new(|| {
+        let (t0, span) = range();
+        Constants {
+            t0: t0 as f32,
+            span: span as f32,
+            pdf_scale: (A / span) as f32,
+            half_inv_a: (0.5 / A) as f32,
+            illuminant: (0..=(LAMBDA_MAX - LAMBDA_MIN) as usize)
+                .map(|i| super::rgb2spec::d65_normalised(LAMBDA_MIN + i as f32))
+                .collect(),
+        }
+    });
+    &C
+}
+
 /// The density per nm of [`sample_visible`] at `lambda` (0 outside `[LAMBDA_MIN, LAMBDA_MAX]`).
 pub fn visible_pdf(lambda: f32) -> f32 {
     if !(LAMBDA_MIN..=LAMBDA_MAX).contains(&lambda) {
@@ -93,21 +122,31 @@ impl Default for HeroWavelengths {
 impl HeroWavelengths {
     /// The four wavelengths of the number `u ∈ [0, 1)` (module docs: `u_i = (u + i/4) mod 1`).
     pub fn sample(u: f32) -> Self {
-        let mut lambda = [0.0; N];
-        let mut pdf = [0.0; N];
+        let c = constants();
+        let mut w = HeroWavelengths {
+            lambda: [0.0; N],
+            pdf: [0.0; N],
+            illuminant: [0.0; N],
+        };
         for i in 0..N {
             let mut ui = u + i as f32 / N as f32;
             if ui >= 1.0 {
                 ui -= 1.0;
             }
-            lambda[i] = sample_visible(ui);
-            pdf[i] = visible_pdf(lambda[i]);
+            let ui = ui.clamp(0.0, 1.0);
+            // As `sample_visible`; the density from `y = tanh(a (λ − μ))` directly, since
+            // sech² = 1 − tanh² (no `cosh`): the same as `visible_pdf(λ)` to rounding.
+            let y = c.t0 + ui * c.span;
+            let l = (MU as f32 + ((1.0 + y) / (1.0 - y)).ln() * c.half_inv_a)
+                .clamp(LAMBDA_MIN, LAMBDA_MAX);
+            w.lambda[i] = l;
+            w.pdf[i] = (1.0 - y * y) * c.pdf_scale;
+            let x = l - LAMBDA_MIN;
+            let j = (x as usize).min(c.illuminant.len() - 2);
+            let f = x - j as f32;
+            w.illuminant[i] = c.illuminant[j] + f * (c.illuminant[j + 1] - c.illuminant[j]);
         }
-        HeroWavelengths {
-            lambda,
-            pdf,
-            illuminant: lambda.map(super::rgb2spec::d65_normalised),
-        }
+        w
     }
 
     /// Keeps only the hero wavelength (module docs); does nothing if already done.
@@ -182,7 +221,16 @@ mod tests {
             quarters.sort_unstable();
             assert_eq!(quarters, vec![0, 1, 2, 3], "u {u}: {:?}", w.lambda);
             for i in 0..N {
-                assert_eq!(w.pdf[i], visible_pdf(w.lambda[i]));
+                // The density from tanh directly (sech² = 1 − tanh²), to rounding.
+                let p = visible_pdf(w.lambda[i]);
+                assert!((w.pdf[i] - p).abs() <= 2e-5 * p, "{} vs {p}", w.pdf[i]);
+                // D65 is linear between its 5 nm values, so the 1 nm table is exact to rounding.
+                let d = crate::spectrum::rgb2spec::d65_normalised(w.lambda[i]);
+                assert!(
+                    (w.illuminant[i] - d).abs() <= 1e-5 * d,
+                    "{} vs {d}",
+                    w.illuminant[i]
+                );
             }
         }
     }

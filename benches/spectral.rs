@@ -1,0 +1,102 @@
+//! What spectral transport costs (issue 19): every shipped gem rendered by the RGB variant and,
+//! forced with `--effect spectral=on`, by the spectral one (four hero wavelengths per path), at
+//! 64 × 48 pixels, 16 spp, Sobol', max depth 8 (`LAPIDARY_BENCH_SIZE=W` renders W × 3W/4), on one
+//! worker thread; worlds are built and the RGB-to-spectrum table is warmed up outside the timed
+//! closure, so the figures are per-sample cost. The issue's target is at most 1.2× the RGB time
+//! (Mitsuba 3's `scalar_spectral` costs about 1.18× `scalar_rgb`).
+//!
+//! Times are the process's CPU time on 64-bit Linux (benches/common/clock.rs). Run with
+//! `cargo bench --bench spectral` (about three minutes); a filter narrows it, e.g.
+//! `cargo bench --bench spectral -- sunstone`. No number here is asserted anywhere.
+
+use criterion::Criterion;
+use lapidary::recipe::GemRecipe;
+use lapidary::render::{Control, Film, World, render};
+use lapidary::scene::{Accuracy, Effect, Scene};
+use std::hint::black_box;
+use std::time::Duration;
+
+#[path = "common/clock.rs"]
+mod clock;
+
+use clock::Clock;
+
+fn width() -> u32 {
+    std::env::var("LAPIDARY_BENCH_SIZE")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .filter(|w| *w >= 4)
+        .unwrap_or(64)
+}
+
+/// A shipped gem at the bench's size, spp, depth and sampler, spectral or not.
+fn gem(path: &std::path::Path, spectral: bool) -> Scene {
+    let mut s = GemRecipe::load(path)
+        .and_then(|r| r.compile())
+        .unwrap_or_else(|e| panic!("{} compiles: {e}", path.display()));
+    let mut acc = Accuracy::default();
+    acc.force(Effect::Spectral, spectral);
+    s.set_accuracy(&acc, "benches/spectral.rs")
+        .expect("spectral can be forced");
+    let r = &mut s.stage.render;
+    r.width = width();
+    r.height = width() * 3 / 4;
+    r.spp = 16;
+    r.max_depth = 8;
+    r.sampler = lapidary::sampler::SamplerKind::Sobol;
+    s
+}
+
+fn run(world: &World, scene: &Scene) -> Film {
+    render(
+        world,
+        &scene.stage.camera,
+        scene.effects.on(Effect::DepthOfField),
+        &scene.stage.render,
+        &Control {
+            threads: Some(1),
+            ..Control::default()
+        },
+    )
+    .film
+}
+
+fn bench(c: &mut Criterion<Clock>) {
+    clock::select(clock::Kind::Process);
+    lapidary::spectrum::rgb2spec::warm_up();
+    lapidary::spectrum::basis::warm_up();
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("gems");
+    let mut gems: Vec<_> = std::fs::read_dir(&dir)
+        .expect("gems/")
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "ron"))
+        .collect();
+    gems.sort();
+    for path in gems {
+        let name = path.file_stem().unwrap().to_string_lossy().to_string();
+        let mut group = c.benchmark_group(format!("spectral/{name}"));
+        group.sample_size(15);
+        group.warm_up_time(Duration::from_millis(500));
+        group.measurement_time(Duration::from_secs(4));
+        for (label, spectral) in [("rgb", false), ("spectral", true)] {
+            let scene = gem(&path, spectral);
+            let world = World::new(&scene).expect("world builds");
+            assert_eq!(world.spectral, spectral);
+            group.bench_function(label, |b| b.iter(|| black_box(run(&world, &scene))));
+        }
+        group.finish();
+    }
+}
+
+fn config() -> Criterion<Clock> {
+    Criterion::default()
+        .with_measurement(clock::measurement())
+        .without_plots()
+}
+
+criterion::criterion_group! {
+    name = benches;
+    config = config();
+    targets = bench
+}
+criterion::criterion_main!(benches);
