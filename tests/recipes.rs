@@ -26,7 +26,7 @@ fn compile(text: &str) -> Scene {
 #[test]
 fn compiling_twice_gives_identical_tables() {
     let gems = shipped();
-    assert_eq!(gems.len(), 10, "{gems:?}");
+    assert_eq!(gems.len(), 11, "{gems:?}");
     let mut hashes = vec![];
     for path in gems {
         let a = GemRecipe::load(&path).unwrap().compile().unwrap();
@@ -36,7 +36,7 @@ fn compiling_twice_gives_identical_tables() {
     }
     hashes.sort_unstable();
     hashes.dedup();
-    assert_eq!(hashes.len(), 10, "every recipe hashes differently");
+    assert_eq!(hashes.len(), 11, "every recipe hashes differently");
 }
 
 #[test]
@@ -349,7 +349,7 @@ fn render_accuracy_knobs_rewrite_materials_and_force_effects() {
     let e = err(format!("({M} stage: (render: (accuracy: (speed: 2))))"));
     assert!(e.contains("t.ron:") && e.contains("speed"), "{e}");
     let e = err(format!(
-        "({M} stage: (render: (accuracy: (effects: {{\"spectral\": true}}))))"
+        "({M} stage: (render: (accuracy: (effects: {{\"fluorescence\": true}}))))"
     ));
     assert!(e.contains("does not simulate"), "{e}");
 }

@@ -221,3 +221,154 @@ fn dispersion_turns_spectral_on_and_rgb_recipes_stay_rgb() {
         assert!(e.contains("bad.ron:") && e.contains(expect), "{body}: {e}");
     }
 }
+
+/// A measured absorption spectrum in a body's medium: spectral transport turns on and names the
+/// line; the RGB render uses the spectrum's projection (a flat spectrum is exactly its grey, so
+/// the RGB film equals that of `absorption` given as the grey); bad points are refused with their
+/// place and the allowed range.
+#[test]
+fn measured_medium_spectra_turn_spectral_on() {
+    let recipe = |medium: &str| {
+        format!(
+            "(materials: {{}},\n surface: Body,\n body: (ior: 1.5,\n medium: {medium}),\n \
+             stage: (shape: Sphere(radius: 1.0), ground: Off, lights: [],\n \
+             environment: Constant(Gray(1.0)),\n camera: Orthographic(from: (0.0, 0.0, 5.0), \
+             to: (0.0, 0.0, 0.0), height: 2.4), render: (width: 24, height: 24, spp: 16)))"
+        )
+    };
+    let measured = GemRecipe::parse(
+        "amber.ron",
+        &recipe("(absorption_spectrum: [(360.0, 0.8), (830.0, 0.8)])"),
+    )
+    .and_then(|r| r.compile())
+    .unwrap();
+    let (why, _) = measured.effects.reason(Effect::Spectral).unwrap();
+    assert!(
+        why.contains("body.medium.absorption_spectrum") && why.contains("amber.ron:4"),
+        "{why}"
+    );
+    let grey = GemRecipe::parse("grey.ron", &recipe("(absorption: (0.8, 0.8, 0.8))"))
+        .and_then(|r| r.compile())
+        .unwrap();
+    assert!(!grey.effects.on(Effect::Spectral));
+    let mut acc = Accuracy::default();
+    acc.force(Effect::Spectral, false);
+    let mut rgb = measured.clone();
+    rgb.set_accuracy(&acc, "test").unwrap();
+    let film = |s: &lapidary::scene::Scene| {
+        render_scene(&World::new(s).unwrap(), s, &Control::default()).film
+    };
+    let (a, b) = (film(&rgb), film(&grey));
+    assert!(
+        a.pixels
+            .iter()
+            .zip(&b.pixels)
+            .all(|(p, q)| p.mean() == q.mean()),
+        "the RGB render of a flat measured spectrum is not that of its grey"
+    );
+    for (medium, expect) in [
+        (
+            "(absorption_spectrum: [(500.0, 1.0), (450.0, 1.0)])",
+            "does not increase",
+        ),
+        (
+            "(absorption_spectrum: [(500.0, 1.0), (600.0, -1.0)])",
+            "0 ..= 10000",
+        ),
+        (
+            "(absorption: (1.0, 1.0, 1.0), absorption_spectrum: [(500.0, 1.0), (600.0, 1.0)])",
+            "absorption_spectrum",
+        ),
+    ] {
+        let e = GemRecipe::parse("bad.ron", &recipe(medium))
+            .and_then(|r| r.compile())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("bad.ron:") && e.contains(expect),
+            "{medium}: {e}"
+        );
+    }
+}
+
+/// Spectral renders are deterministic: the same recipe, seed and spp give the same film for one
+/// and for two worker threads (the conversions' per-thread memos return exactly what they would
+/// compute).
+#[test]
+fn spectral_renders_do_not_depend_on_the_thread_count() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("gems/sunstone.ron");
+    let mut scene = GemRecipe::load(&path).and_then(|r| r.compile()).unwrap();
+    let mut acc = Accuracy::default();
+    acc.force(Effect::Spectral, true);
+    scene.set_accuracy(&acc, "test").unwrap();
+    scene.stage.render.width = 48;
+    scene.stage.render.height = 36;
+    scene.stage.render.spp = 8;
+    let world = World::new(&scene).unwrap();
+    let film = |threads| {
+        render_scene(
+            &world,
+            &scene,
+            &Control {
+                threads: Some(threads),
+                ..Control::default()
+            },
+        )
+        .film
+    };
+    let (one, two) = (film(1), film(2));
+    assert!(one.pixels == two.pixels, "1 and 2 threads differ");
+}
+
+/// A measured light spectrum: the light keeps the luminance of `radiance × intensity` and takes
+/// the spectrum's colour; spectral paths read the spectrum itself at their wavelengths; the
+/// effect names the light; a spectrum without luminance is refused at its line.
+#[test]
+fn measured_light_spectra() {
+    let recipe = |spectrum: &str| {
+        format!(
+            "(materials: {{ \"white\": (base: Lambert(albedo: Gray(0.8))) }},\n surface: Material(\"white\"),\n \
+             stage: (shape: Sphere(radius: 1.0), ground: Off,\n \
+             lights: [Rect(center: (0.0, 4.0, 2.0), size: (2.0, 2.0), radiance: Gray(3.0), intensity: 2.0,\n \
+             spectrum: {spectrum})],\n environment: Constant(Gray(0.0)),\n \
+             camera: Orthographic(from: (0.0, 0.0, 5.0), to: (0.0, 0.0, 0.0), height: 2.4)))"
+        )
+    };
+    // Sodium-like line at 589 nm.
+    let scene = GemRecipe::parse(
+        "sodium.ron",
+        &recipe("[(580.0, 0.0), (589.0, 1.0), (598.0, 0.0)]"),
+    )
+    .and_then(|r| r.compile())
+    .unwrap();
+    let (why, _) = scene.effects.reason(Effect::Spectral).unwrap();
+    assert!(why.contains("stage.lights[0].spectrum"), "{why}");
+    let light = &scene.stage.lights[0];
+    let m = light.spectrum.expect("the light keeps its spectrum");
+    // Luminance of the spectrum = that of radiance × intensity (6).
+    assert!((m.luminance() - 6.0).abs() < 1e-3, "{}", m.luminance());
+    // Its RGB is orange-yellow (sRGB clamps the out-of-gamut part).
+    let c = light.radiance;
+    assert!(c[0] > c[1] && c[1] > c[2], "{c:?}");
+    let world = World::new(&scene).unwrap();
+    assert!(world.spectral);
+    let lambda = HeroWavelengths::sample(0.3);
+    let e: HeroSample = world.areas[0].emission(light.radiance, &lambda);
+    for i in 0..4 {
+        assert_eq!(e.0[i], m.at(lambda.lambda[i]));
+    }
+    // The RGB variant sees the projection, exactly.
+    let rgb: lapidary::spectrum::RgbSample =
+        world.areas[0].emission(light.radiance, &lapidary::spectrum::RgbWavelengths);
+    assert_eq!(lapidary::color::Rgb::from(rgb), light.radiance);
+    let e = GemRecipe::parse("dark.ron", &recipe("[(400.0, 0.0), (700.0, 0.0)]"))
+        .and_then(|r| r.compile())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("dark.ron:")
+            && e.contains("stage.lights[0].spectrum")
+            && e.contains("luminance"),
+        "{e}"
+    );
+}

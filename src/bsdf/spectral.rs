@@ -486,7 +486,13 @@ mod tests {
             let r: BsdfSample<HeroSample> = b
                 .sample_at(wo, 0.0, Vec2::ZERO, TransportMode::Radiance, &l)
                 .unwrap();
-            assert!(!r.terminate_secondary && r.weight.0.iter().all(|&w| w > 0.9 && w < 1.1));
+            assert!(!r.terminate_secondary);
+            // Each wavelength's own Fresnel factor over the hero's choice probability.
+            let f0 = fresnel::dielectric(wo.z, n);
+            for i in 0..4 {
+                let want = fresnel::dielectric(wo.z, law.eta_at(l.lambda[i])) / f0;
+                assert!((r.weight.0[i] - want).abs() < 1e-5 * want, "{i}");
+            }
         }
     }
 }

@@ -154,8 +154,15 @@ pub fn describe(recipe: &GemRecipe, scene: &Scene, points: u32) -> String {
         };
         let interior = match &b.medium {
             Some(m) if b.has_medium() => format!(
-                "σa {:.4?}, σs {:.4?} per object unit, g {}",
-                m.sigma_a.0, m.sigma_s.0, m.g
+                "σa {:.4?}, σs {:.4?} per object unit, g {}{}",
+                m.sigma_a.0,
+                m.sigma_s.0,
+                m.g,
+                if b.has_measured_medium() {
+                    " (measured spectra; RGB shows their projection)"
+                } else {
+                    ""
+                }
             ),
             _ => "clear".into(),
         };

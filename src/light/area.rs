@@ -16,6 +16,8 @@ use crate::color::Rgb;
 use crate::geometry::{Frame, Ray};
 use crate::sampler::concentric_disc;
 use crate::scene::stage::{AreaLight, LightShape};
+use crate::spectrum::Spectral;
+use crate::spectrum::measured::Measured;
 use glam::{DVec3, Vec2, Vec3};
 use std::f32::consts::PI;
 
@@ -47,6 +49,7 @@ pub struct Area {
     radiance: Rgb,
     two_sided: bool,
     area: f32,
+    spectrum: Option<Measured>,
 }
 
 /// The spherical rectangle a rectangle subtends from a point `o` (Ureña et al. 2013, §3), in
@@ -111,6 +114,24 @@ impl Area {
             radiance,
             two_sided: light.two_sided,
             area: if ok { area } else { 0.0 },
+            spectrum: light.spectrum,
+        }
+    }
+
+    /// The light's measured emission spectrum, if the recipe gave one (its RGB colour is what
+    /// [`Area::emitted`] returns).
+    pub fn spectrum(&self) -> Option<&Measured> {
+        self.spectrum.as_ref()
+    }
+
+    /// Emitted radiance `rgb` (what [`Area::emitted`] or a light sample returned) at the path's
+    /// wavelengths: the measured spectrum where the light has one and `rgb` is not zero (a face
+    /// that does not emit), else the colour's illuminant spectrum.
+    #[inline]
+    pub fn emission<S: Spectral>(&self, rgb: Rgb, lambda: &S::Wavelengths) -> S {
+        match &self.spectrum {
+            Some(m) if rgb != Rgb::ZERO => S::from_measured(m, rgb, lambda),
+            _ => S::from_illuminant(rgb, lambda),
         }
     }
 
@@ -346,6 +367,7 @@ mod tests {
             shape,
             radiance,
             two_sided,
+            spectrum: None,
         })
     }
 

@@ -6,6 +6,17 @@
 use super::{FreeFlight, HenyeyGreenstein};
 use crate::color::Rgb;
 use crate::spectrum::Spectral;
+use crate::spectrum::measured::Measured;
+
+/// A coefficient at the wavelengths: the measured spectrum where there is one, else the RGB
+/// value's spectrum.
+#[inline]
+fn coefficient<S: Spectral>(rgb: Rgb, measured: &Option<Measured>, lambda: &S::Wavelengths) -> S {
+    match measured {
+        Some(m) => S::from_measured(m, rgb, lambda),
+        None => S::from_unbounded(rgb, lambda),
+    }
+}
 
 /// Constant coefficients, per world unit of length, and a phase function.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -16,6 +27,11 @@ pub struct Homogeneous {
     pub sigma_s: Rgb,
     /// The phase function at scattering points.
     pub phase: HenyeyGreenstein,
+    /// A measured absorption spectrum, per world unit (`sigma_a` is then its RGB projection):
+    /// spectral paths read it at their wavelengths.
+    pub sigma_a_measured: Option<Measured>,
+    /// A measured scattering spectrum, per world unit (`sigma_s` is its RGB projection).
+    pub sigma_s_measured: Option<Measured>,
 }
 
 /// `exp(−σ t)` per channel, exactly 1 where `σ = 0` (also for `t = ∞`).
@@ -29,6 +45,7 @@ impl Homogeneous {
     #[inline]
     pub fn scatters(&self) -> bool {
         self.sigma_s.0.iter().any(|&s| s > 0.0)
+            || self.sigma_s_measured.is_some_and(|m| m.max() > 0.0)
     }
 
     /// The same medium without scattering: light that would scatter continues straight on, so
@@ -36,6 +53,7 @@ impl Homogeneous {
     pub fn without_scattering(self) -> Self {
         Homogeneous {
             sigma_s: Rgb::ZERO,
+            sigma_s_measured: None,
             ..self
         }
     }
@@ -55,8 +73,8 @@ impl Homogeneous {
     /// See [`super::Medium::transmittance`].
     #[inline]
     pub fn transmittance<S: Spectral>(&self, t: f32, lambda: &S::Wavelengths) -> S {
-        let sigma_t =
-            S::from_unbounded(self.sigma_a, lambda) + S::from_unbounded(self.sigma_s, lambda);
+        let sigma_t = coefficient::<S>(self.sigma_a, &self.sigma_a_measured, lambda)
+            + coefficient::<S>(self.sigma_s, &self.sigma_s_measured, lambda);
         transmittance(sigma_t, t)
     }
 
@@ -69,7 +87,7 @@ impl Homogeneous {
         u: f32,
         lambda: &S::Wavelengths,
     ) -> FreeFlight<S> {
-        let sigma_a = S::from_unbounded(self.sigma_a, lambda);
+        let sigma_a = coefficient::<S>(self.sigma_a, &self.sigma_a_measured, lambda);
         if !self.scatters() {
             // Nothing is sampled: the same (deterministic) event for every channel.
             return FreeFlight::Pass {
@@ -77,7 +95,7 @@ impl Homogeneous {
                 pdf: S::ONE,
             };
         }
-        let sigma_s = S::from_unbounded(self.sigma_s, lambda);
+        let sigma_s = coefficient::<S>(self.sigma_s, &self.sigma_s_measured, lambda);
         let sigma_t = sigma_a + sigma_s;
         let st = sigma_t.channel(hero);
         let t = if st > 0.0 {
@@ -109,6 +127,8 @@ mod tests {
             sigma_a: Rgb(a),
             sigma_s: Rgb(s),
             phase: HenyeyGreenstein::new(0.0),
+            sigma_a_measured: None,
+            sigma_s_measured: None,
         }
     }
 
@@ -182,5 +202,34 @@ mod tests {
             panic!()
         };
         assert_eq!((value, pdf), (RgbSample::ONE, RgbSample::ONE));
+    }
+
+    /// A measured absorption spectrum: spectral paths see `exp(−σa(λ) t)` at each wavelength;
+    /// the RGB variant its projection.
+    #[test]
+    fn measured_absorption_is_read_per_wavelength() {
+        use crate::spectrum::HeroSample;
+        use crate::spectrum::wavelengths::HeroWavelengths;
+        let m = Measured::from_points(
+            &[(360.0, 0.2), (550.0, 0.2), (560.0, 3.0), (830.0, 3.0)],
+            1e4,
+        )
+        .unwrap();
+        let h = Homogeneous {
+            sigma_a: m.to_rgb(),
+            sigma_a_measured: Some(m),
+            ..medium([0.0; 3], [0.0; 3])
+        };
+        let lambda = HeroWavelengths::sample(0.41);
+        let t = 0.7;
+        let tr = h.transmittance::<HeroSample>(t, &lambda);
+        for i in 0..4 {
+            let want = (-m.at(lambda.lambda[i]) * t).exp();
+            assert!((tr.0[i] - want).abs() < 1e-6, "{} nm", lambda.lambda[i]);
+        }
+        let rgb = h.transmittance::<RgbSample>(t, &RgbWavelengths);
+        for c in 0..3 {
+            assert!((rgb.0[c] - (-m.to_rgb()[c] * t).exp()).abs() < 1e-6);
+        }
     }
 }

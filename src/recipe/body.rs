@@ -28,6 +28,7 @@ use crate::bsdf::dispersion::{Ior, LAMBDA_D};
 use crate::bsdf::{Distribution, Masking};
 use crate::color::Rgb;
 use crate::medium::phase::G_LIMIT;
+use crate::spectrum::measured::Measured;
 use serde::{Deserialize, Deserializer, Serialize};
 
 /// Largest coefficient (per object unit) a recipe may give.
@@ -164,6 +165,14 @@ pub struct MediumDesc {
     /// The phase function (default isotropic).
     #[serde(default)]
     pub phase: PhaseDesc,
+    /// A measured absorption spectrum: `(wavelength nm, σa per object unit)` points, wavelengths
+    /// increasing in 200 ..= 2000, values 0 ..= 1e4, 2 ..= 4096 points. Not with `absorption`
+    /// or `colour`. Turns spectral transport on; RGB renders use its projection.
+    #[serde(default)]
+    pub absorption_spectrum: Option<Vec<(f32, f32)>>,
+    /// A measured scattering spectrum, as `absorption_spectrum` (σs). Not with `scattering`.
+    #[serde(default)]
+    pub scattering_spectrum: Option<Vec<(f32, f32)>>,
 }
 
 /// A phase function.
@@ -293,8 +302,61 @@ impl BodyDesc {
     }
 }
 
+/// A medium's coefficients per object unit as compiled: RGB values and, where the recipe gave
+/// them, the measured spectra they are the projections of.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Coefficients {
+    /// `σa` (RGB).
+    pub sigma_a: Rgb,
+    /// `σs` (RGB).
+    pub sigma_s: Rgb,
+    /// Measured `σa(λ)`.
+    pub sigma_a_measured: Option<Measured>,
+    /// Measured `σs(λ)`.
+    pub sigma_s_measured: Option<Measured>,
+}
+
 impl MediumDesc {
-    /// `σa` and `σs` per object unit, or what is wrong.
+    /// The coefficients per object unit, with the measured spectra where given, or what is
+    /// wrong.
+    pub fn measured_coefficients(&self) -> Result<Coefficients, String> {
+        let spectrum = |what: &str, pts: &Option<Vec<(f32, f32)>>| {
+            pts.as_ref()
+                .map(|p| {
+                    Measured::from_points(p, SIGMA_MAX).map_err(|e| format!("medium.{what}: {e}"))
+                })
+                .transpose()
+        };
+        let a = spectrum("absorption_spectrum", &self.absorption_spectrum)?;
+        let s = spectrum("scattering_spectrum", &self.scattering_spectrum)?;
+        if a.is_some() && (self.absorption.is_some() || self.colour.is_some()) {
+            return Err(
+                "medium: give the absorption as one of `absorption`, `colour` and `distance`, or \
+                 `absorption_spectrum`"
+                    .into(),
+            );
+        }
+        if s.is_some() && self.scattering != (0.0, 0.0, 0.0) {
+            return Err(
+                "medium: give either `scattering` or `scattering_spectrum`, not both".into(),
+            );
+        }
+        let (mut sigma_a, mut sigma_s) = self.coefficients()?;
+        if let Some(m) = a {
+            sigma_a = m.to_rgb();
+        }
+        if let Some(m) = s {
+            sigma_s = m.to_rgb();
+        }
+        Ok(Coefficients {
+            sigma_a,
+            sigma_s,
+            sigma_a_measured: a,
+            sigma_s_measured: s,
+        })
+    }
+
+    /// `σa` and `σs` per object unit (RGB, ignoring measured spectra), or what is wrong.
     pub fn coefficients(&self) -> Result<(Rgb, Rgb), String> {
         let sigma_a = match (&self.absorption, &self.colour, self.distance) {
             (Some(a), None, None) => Rgb::new(a.0, a.1, a.2),

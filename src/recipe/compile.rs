@@ -305,11 +305,13 @@ impl Compiler<'_> {
         };
         let medium = match &desc.medium {
             None => None,
-            Some(m) => match m.coefficients() {
-                Ok((sigma_a, sigma_s)) => Some(Interior {
-                    sigma_a,
-                    sigma_s,
+            Some(m) => match m.measured_coefficients() {
+                Ok(c) => Some(Interior {
+                    sigma_a: c.sigma_a,
+                    sigma_s: c.sigma_s,
                     g: m.phase.g(),
+                    sigma_a_measured: c.sigma_a_measured,
+                    sigma_s_measured: c.sigma_s_measured,
                 }),
                 Err(msg) => {
                     let at = r.source.find_from(at.unwrap_or(0), &["medium", ":"]).or(at);
@@ -341,6 +343,25 @@ impl Compiler<'_> {
                     Effect::Spectral,
                     format!("body.dispersion ({}:{})", e.file, e.line),
                 );
+            }
+            for (key, given) in [
+                (
+                    "absorption_spectrum",
+                    body.medium.is_some_and(|m| m.sigma_a_measured.is_some()),
+                ),
+                (
+                    "scattering_spectrum",
+                    body.medium.is_some_and(|m| m.sigma_s_measured.is_some()),
+                ),
+            ] {
+                if given {
+                    let d = r.source.find_from(at.unwrap_or(0), &[key, ":"]).or(at);
+                    let e = r.source.error(d, "");
+                    self.effects.turn_on(
+                        Effect::Spectral,
+                        format!("body.medium.{key} ({}:{})", e.file, e.line),
+                    );
+                }
             }
             if !body.platelets.is_empty() {
                 let p = r

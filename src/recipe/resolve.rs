@@ -14,6 +14,7 @@ use crate::scene::stage::{
     Stage, placement, rect_light,
 };
 use crate::scene::{Effect, Effects};
+use crate::spectrum::measured::Measured;
 use glam::Vec3;
 use std::path::PathBuf;
 
@@ -138,29 +139,65 @@ pub(crate) fn stage(
                 ));
                 continue;
             }
+            let (radiance, spectrum) = match l {
+                LightDesc::Rect {
+                    radiance,
+                    intensity,
+                    spectrum,
+                    ..
+                }
+                | LightDesc::Disc {
+                    radiance,
+                    intensity,
+                    spectrum,
+                    ..
+                } => (colour(radiance) * *intensity, spectrum),
+            };
+            // A measured spectrum keeps the light's luminance and gives it its colour.
+            let (radiance, spectrum) = match spectrum {
+                None => (radiance, None),
+                Some(points) => {
+                    let fail = |m: String| {
+                        let at = lights_at.and_then(|l| src.nth_element(l, i)).or(lights_at);
+                        let at = at.and_then(|a| src.find_from(a, &["spectrum", ":"])).or(at);
+                        src.error(at, format!("stage.lights[{i}].spectrum: {m}"))
+                    };
+                    match Measured::from_points(points, 1e9) {
+                        Err(m) => {
+                            errors.push(fail(m));
+                            continue;
+                        }
+                        Ok(m) if !(m.luminance() > 0.0) => {
+                            errors.push(fail(
+                                "the spectrum has no luminance (it is zero over 360 ..= 830 nm)"
+                                    .into(),
+                            ));
+                            continue;
+                        }
+                        Ok(m) => {
+                            let m = m.scaled(radiance.luminance() / m.luminance());
+                            (m.to_rgb_emission(), Some(m))
+                        }
+                    }
+                }
+            };
             stage.lights.push(match l {
                 LightDesc::Rect {
-                    size,
-                    radiance,
-                    intensity,
-                    two_sided,
-                    ..
+                    size, two_sided, ..
                 } => AreaLight {
                     two_sided: *two_sided,
-                    ..rect_light(center, target, *size, colour(radiance) * *intensity)
+                    spectrum,
+                    ..rect_light(center, target, *size, radiance)
                 },
                 LightDesc::Disc {
-                    radius,
-                    radiance,
-                    intensity,
-                    two_sided,
-                    ..
+                    radius, two_sided, ..
                 } => AreaLight {
                     center,
                     normal: (target - center).normalize(),
                     shape: LightShape::Disc { radius: *radius },
-                    radiance: colour(radiance) * *intensity,
+                    radiance,
                     two_sided: *two_sided,
+                    spectrum,
                 },
             });
         }
@@ -266,5 +303,10 @@ pub(crate) fn stage_effects(stage: &Stage, effects: &mut Effects) {
             Effect::EnvironmentImportance,
             format!("stage.environment Map(\"{}\")", path.display()),
         );
+    }
+    for (i, l) in stage.lights.iter().enumerate() {
+        if l.spectrum.is_some() {
+            effects.turn_on(Effect::Spectral, format!("stage.lights[{i}].spectrum"));
+        }
     }
 }

@@ -333,6 +333,11 @@ pub enum LightDesc {
         /// Emit from both faces (default false: only towards `target`).
         #[serde(default)]
         two_sided: bool,
+        /// A measured relative spectral power distribution, `[(nm, power), …]`: the light emits
+        /// this spectrum scaled to the luminance of `radiance × intensity` (its colour replaces
+        /// `radiance`'s). Turns spectral transport on.
+        #[serde(default)]
+        spectrum: Option<Vec<(f32, f32)>>,
     },
     /// A disc.
     Disc {
@@ -354,6 +359,9 @@ pub enum LightDesc {
         /// Emit from both faces (default false).
         #[serde(default)]
         two_sided: bool,
+        /// A measured relative spectral power distribution (as for `Rect`).
+        #[serde(default)]
+        spectrum: Option<Vec<(f32, f32)>>,
     },
 }
 

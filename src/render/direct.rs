@@ -71,7 +71,10 @@ pub(super) fn direct_light<S: Spectral>(
         Strategy::Mis => power_heuristic(p_light, sb.pdf::<S>(wo_local, wi_local, &path.lambda)),
         _ => 1.0,
     };
-    let radiance = S::from_illuminant(ls.radiance, &path.lambda);
+    let radiance = match light {
+        LightRef::Area(i) => world.areas[i].emission::<S>(ls.radiance, &path.lambda),
+        LightRef::Environment => S::from_illuminant(ls.radiance, &path.lambda),
+    };
     let c = path.throughput() * f * radiance * (wi_local.z.abs() * w / p_light);
     if c.is_valid() {
         path.l += c;

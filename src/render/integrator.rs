@@ -233,7 +233,8 @@ where
                 break;
             }
             Some(Hit::Light { index, t }) => {
-                let le = S::from_illuminant(world.areas[index].emitted(-ray.dir), &path.lambda);
+                let le = world.areas[index]
+                    .emission::<S>(world.areas[index].emitted(-ray.dir), &path.lambda);
                 let w = match (path.manifold, &world.manifold) {
                     // The walk's chain of refractions since a vertex where the walk ran.
                     (Some(v), Some(setup)) if v.crossings == v.chain.crossings() => {

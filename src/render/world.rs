@@ -238,6 +238,8 @@ impl World {
                 sigma_a: Rgb::ZERO,
                 sigma_s: Rgb::ZERO,
                 phase: crate::medium::HenyeyGreenstein::new(0.0),
+                sigma_a_measured: None,
+                sigma_s_measured: None,
             })
         } else {
             Medium::Vacuum

@@ -7,6 +7,7 @@ use crate::bsdf::{SmoothDielectric, StackDesc};
 use crate::color::Rgb;
 use crate::medium::{HenyeyGreenstein, Homogeneous, Medium};
 use crate::platelet::Population;
+use crate::spectrum::measured::Measured;
 
 /// Stratification grid of a rough boundary's energy tables (`64² · 4` samples per entry): light
 /// meets a stone's boundary many times (total internal reflection), so the tables' noise adds up;
@@ -47,6 +48,10 @@ pub struct Interior {
     pub sigma_s: Rgb,
     /// Henyey–Greenstein asymmetry.
     pub g: f32,
+    /// A measured absorption spectrum per object unit (`sigma_a` is its RGB projection).
+    pub sigma_a_measured: Option<Measured>,
+    /// A measured scattering spectrum per object unit (`sigma_s` is its RGB projection).
+    pub sigma_s_measured: Option<Measured>,
 }
 
 impl Body {
@@ -86,6 +91,8 @@ impl Body {
                     sigma_a: m.sigma_a * (1.0 / scale),
                     sigma_s: m.sigma_s * (1.0 / scale),
                     phase: HenyeyGreenstein::new(m.g),
+                    sigma_a_measured: m.sigma_a_measured.map(|s| s.scaled(1.0 / scale)),
+                    sigma_s_measured: m.sigma_s_measured.map(|s| s.scaled(1.0 / scale)),
                 };
                 Medium::Homogeneous(if scattering {
                     h
@@ -117,7 +124,17 @@ impl Body {
 
     /// Whether the interior absorbs or scatters at all (the `medium` effect).
     pub fn has_medium(&self) -> bool {
+        self.medium.is_some_and(|m| {
+            m.sigma_a != Rgb::ZERO
+                || m.sigma_s != Rgb::ZERO
+                || m.sigma_a_measured.is_some_and(|s| s.max() > 0.0)
+                || m.sigma_s_measured.is_some_and(|s| s.max() > 0.0)
+        })
+    }
+
+    /// Whether the interior is given by a measured spectrum (which turns spectral transport on).
+    pub fn has_measured_medium(&self) -> bool {
         self.medium
-            .is_some_and(|m| m.sigma_a != Rgb::ZERO || m.sigma_s != Rgb::ZERO)
+            .is_some_and(|m| m.sigma_a_measured.is_some() || m.sigma_s_measured.is_some())
     }
 }

@@ -108,7 +108,8 @@ impl Effect {
                 "a smooth `body` boundary on a stage with a floor, under an area light"
             }
             Effect::Spectral => {
-                "a dispersive `body` IOR (Cauchy, Sellmeier or Abbe number), or `--spectral`"
+                "a dispersive `body` IOR (Cauchy, Sellmeier or Abbe number), a measured medium or \
+                 light spectrum, or `--spectral`"
             }
             Effect::Fluorescence => "a fluorescent material",
             Effect::DepthOfField => "a perspective camera with aperture > 0",

@@ -88,6 +88,9 @@ pub struct AreaLight {
     pub radiance: Rgb,
     /// Emits from both faces.
     pub two_sided: bool,
+    /// A measured emission spectrum (`radiance` is then its RGB colour): spectral paths read it
+    /// at their wavelengths.
+    pub spectrum: Option<crate::spectrum::measured::Measured>,
 }
 
 /// The camera projection.
@@ -230,6 +233,7 @@ pub fn rect_light(center: Vec3, target: Vec3, size: (f32, f32), radiance: Rgb) -
         shape: LightShape::Rect { u, v },
         radiance,
         two_sided: false,
+        spectrum: None,
     }
 }
 
@@ -293,6 +297,7 @@ impl Stage {
                     shape: LightShape::Disc { radius: 0.06 },
                     radiance: Rgb::splat(2500.0),
                     two_sided: false,
+                    spectrum: None,
                 },
             ],
             camera,

@@ -193,6 +193,10 @@ impl Spectral for HeroSample {
         })
     }
 
+    fn from_measured(m: &super::measured::Measured, _rgb: Rgb, lambda: &HeroWavelengths) -> Self {
+        HeroSample::at(lambda, |l| m.at(l))
+    }
+
     fn to_rgb(self, lambda: &HeroWavelengths) -> Rgb {
         let mut xyz = [0.0f64; 3];
         for i in 0..N {

@@ -26,6 +26,7 @@
 pub mod basis;
 pub mod cie;
 pub mod hero;
+pub mod measured;
 pub mod rgb;
 pub mod rgb2spec;
 pub mod wavelengths;
@@ -89,6 +90,14 @@ pub trait Spectral:
     #[inline]
     fn from_illuminant(c: Rgb, lambda: &Self::Wavelengths) -> Self {
         Self::from_unbounded(c, lambda)
+    }
+    /// A measured coefficient spectrum (a medium's absorption or scattering) at the wavelengths;
+    /// `rgb` is its projection ([`measured::Measured::to_rgb`]), which is what the RGB variant
+    /// (this default) uses.
+    #[inline]
+    fn from_measured(m: &measured::Measured, rgb: Rgb, lambda: &Self::Wavelengths) -> Self {
+        let _ = m;
+        Self::from_unbounded(rgb, lambda)
     }
     /// The film colour of a path's radiance estimate carried at `lambda` (for a spectral variant
     /// this divides by the wavelengths' density and projects onto the colour matching functions).

@@ -132,7 +132,7 @@ pub fn sample_light<S: Spectral>(
         ),
     };
     let pdf = q * p_pick / (light.area() * c.jacobian);
-    let value = tr * S::from_illuminant(le, lambda) * (cross * scale / pdf);
+    let value = tr * light.emission::<S>(le, lambda) * (cross * scale / pdf);
     (pdf.is_finite() && pdf > 0.0 && value.is_valid()).then_some(ManifoldLight {
         d: c.d,
         value,
