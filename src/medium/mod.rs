@@ -32,6 +32,10 @@ pub use phase::{HenyeyGreenstein, PhaseSample};
 use crate::spectrum::Spectral;
 
 /// A medium a ray can travel through.
+// `Homogeneous` carries its measured spectra inline (two 48-value grids): media live in one small
+// per-world `Vec` read by reference, and inline grids keep the free-flight code free of a pointer
+// chase; the size difference to `Vacuum` costs a few hundred bytes per world.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Medium {
     /// Nothing: no absorption, no scattering.
