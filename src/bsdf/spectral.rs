@@ -28,8 +28,7 @@ use super::dispersion::Dispersion;
 use super::layered::Model;
 use super::{
     Bsdf, BsdfSample, Bxdf, Lambert, Lobe, LobeKind, OrenNayar, RoughDielectric, SmoothDielectric,
-    TorranceSparrow, TransportMode, flush_tiny, fresnel, reflect, refract,
-    sample_cosine_hemisphere,
+    TorranceSparrow, TransportMode, flush_tiny, fresnel, refract, sample_cosine_hemisphere,
 };
 use crate::color::Rgb;
 use crate::spectrum::wavelengths::HeroWavelengths;
@@ -155,17 +154,7 @@ impl Scatter<HeroSample> for Bsdf {
                 diffuse(wi, f, Bxdf::<RgbSample>::pdf(self, wo, wi))
             }
             Bsdf::TorranceSparrow(b) => {
-                if wo.z <= 0.0 {
-                    return None;
-                }
-                let (h, _) = b.distribution.sample_visible(wo, uc, u)?;
-                if wo.dot(h) <= 0.0 {
-                    return None;
-                }
-                let wi = reflect(wo, h).normalize();
-                if wi.z <= 0.0 {
-                    return None;
-                }
+                let wi = b.sample_wi(wo, uc, u)?;
                 BsdfSample::from_eval(
                     wi,
                     torrance_sparrow(b, wo, wi, lambda),

@@ -103,6 +103,21 @@ impl TorranceSparrow {
         }
     }
 
+    /// The sampled direction: `wo` reflected about a visible micro-normal (module docs); `None`
+    /// below the horizon. Shared by the RGB and spectral samplers.
+    #[inline]
+    pub(crate) fn sample_wi(&self, wo: Vec3, uc: f32, u: Vec2) -> Option<Vec3> {
+        if wo.z <= 0.0 {
+            return None;
+        }
+        let (h, _) = self.distribution.sample_visible(wo, uc, u)?;
+        if wo.dot(h) <= 0.0 {
+            return None;
+        }
+        let wi = reflect(wo, h).normalize();
+        (wi.z > 0.0).then_some(wi)
+    }
+
     /// The half vector of two upper-hemisphere directions, `None` when undefined (`wo = −wi`).
     #[inline]
     pub(crate) fn half(wo: Vec3, wi: Vec3) -> Option<Vec3> {
@@ -146,17 +161,7 @@ impl Bxdf for TorranceSparrow {
 
     #[inline]
     fn sample_mode(&self, wo: Vec3, uc: f32, u: Vec2, _mode: TransportMode) -> Option<BsdfSample> {
-        if wo.z <= 0.0 {
-            return None;
-        }
-        let (h, _) = self.distribution.sample_visible(wo, uc, u)?;
-        if wo.dot(h) <= 0.0 {
-            return None;
-        }
-        let wi = reflect(wo, h).normalize();
-        if wi.z <= 0.0 {
-            return None;
-        }
+        let wi = self.sample_wi(wo, uc, u)?;
         BsdfSample::from_eval(
             wi,
             self.eval(wo, wi),
