@@ -10,15 +10,21 @@
 //!
 //! A failure writes the test render, the reference and a heatmap under `target/golden/` and names
 //! them in the message.
+//!
+//! The bias tests of `compare` (module `bias`, issue 14) share these renders: one golden render of
+//! every scene serves both.
+
+#[path = "golden/bias.rs"]
+mod bias;
 
 use lapidary::image::compare::{Comparison, ZTest, compare};
 use lapidary::image::write_heatmap;
 use lapidary::image::{ExrImage, read_exr, write_exr};
 use lapidary::recipe::GemRecipe;
-use lapidary::render::{Control, Metadata, World, exr_image, render};
+use lapidary::render::{Control, Metadata, World, exr_image, render_scene};
 use lapidary::sampler::SamplerKind;
-use lapidary::scene::Effect;
 use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
 
 /// The recipe a reference belongs to.
 fn recipe_of(name: &str) -> PathBuf {
@@ -30,26 +36,54 @@ fn recipe_of(name: &str) -> PathBuf {
     }
 }
 
-/// Renders `recipe` as the golden tests do.
-fn render_test(recipe: &Path) -> ExrImage {
-    let gem = GemRecipe::load(recipe).unwrap_or_else(|e| panic!("{e}"));
+/// The golden scenes: every reference in `tests/refs/`, sorted by name.
+fn scenes() -> Vec<String> {
+    references().into_iter().map(|(n, _)| n).collect()
+}
+
+/// The reference `tests/refs/NAME.exr`.
+fn reference(name: &str) -> ExrImage {
+    read_exr(&Path::new("tests/refs").join(format!("{name}.exr"))).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Renders `text` (recipe source, read as if it were the file `recipe`) at `size`² and `spp`
+/// with the independent sampler and `seed`, as the golden tests do.
+fn render_text(recipe: &Path, text: &str, size: u32, spp: u32, seed: u64) -> ExrImage {
+    let file = recipe.to_str().unwrap();
+    let gem = GemRecipe::parse(file, text).unwrap_or_else(|e| panic!("{e}"));
     let mut scene = gem.compile().unwrap_or_else(|e| panic!("{e}"));
     let r = &mut scene.stage.render;
-    r.width = 96;
-    r.height = 96;
-    r.spp = 256;
-    r.seed = 7;
+    (r.width, r.height, r.spp, r.seed) = (size, size, spp, seed);
     r.sampler = SamplerKind::Independent;
     let world = World::new(&scene).expect("world");
-    let rendered = render(
-        &world,
-        &scene.stage.camera,
-        scene.effects.on(Effect::DepthOfField),
-        &scene.stage.render,
-        &Control::default(),
-    );
-    let meta = Metadata::of(&recipe.display().to_string(), &scene);
-    exr_image(&rendered, &meta)
+    let rendered = render_scene(&world, &scene, &Control::default());
+    exr_image(&rendered, &Metadata::of(file, &scene))
+}
+
+/// Every golden scene at the golden settings (96×96, 256 spp, independent, seed 7), rendered once
+/// for all tests of this binary.
+fn golden_renders() -> &'static [(String, ExrImage)] {
+    static RENDERS: OnceLock<Vec<(String, ExrImage)>> = OnceLock::new();
+    RENDERS.get_or_init(|| {
+        scenes()
+            .into_iter()
+            .map(|n| {
+                let recipe = recipe_of(&n);
+                let text = std::fs::read_to_string(&recipe).unwrap();
+                let img = render_text(&recipe, &text, 96, 256, 7);
+                (n, img)
+            })
+            .collect()
+    })
+}
+
+/// The golden render of `name`.
+fn golden(name: &str) -> &'static ExrImage {
+    golden_renders()
+        .iter()
+        .find(|(n, _)| n == name)
+        .map(|(_, img)| img)
+        .unwrap_or_else(|| panic!("no golden scene {name}"))
 }
 
 /// Writes the evidence of a failed comparison and returns a message naming it.
@@ -123,8 +157,8 @@ fn golden_renders_match_their_references() {
     let mut failures = Vec::new();
     for (name, path) in &refs {
         let reference = read_exr(path).unwrap_or_else(|e| panic!("{e}"));
-        let test = render_test(&recipe_of(name));
-        let c = compare(&test, &reference).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let test = golden(name);
+        let c = compare(test, &reference).unwrap_or_else(|e| panic!("{name}: {e}"));
         let z = c.ztest.as_ref().expect("references carry variance");
         eprintln!(
             "{name}: {:.2} % of pixels pass (max |z| {:.2}, limit {:.2}), relMSE {:.2e}, FLIP {:.4}; \
@@ -137,7 +171,7 @@ fn golden_renders_match_their_references() {
             scales(z)
         );
         if !c.passed {
-            failures.push(evidence(name, &test, &reference, &c));
+            failures.push(evidence(name, test, &reference, &c));
         }
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
@@ -149,8 +183,8 @@ fn golden_comparison_has_power() {
     // against their references. (Per-pixel tests of a 256-spp gem are blind to a few per cent:
     // its pixels' relative noise is 10–30 %; the analytic scenes carry the fine checks.)
     for (name, scale) in [("mirror", 1.02f32), ("lepidolite", 1.3)] {
-        let reference = read_exr(&Path::new("tests/refs").join(format!("{name}.exr"))).unwrap();
-        let mut test = render_test(&recipe_of(name));
+        let reference = reference(name);
+        let mut test = golden(name).clone();
         for ch in &mut test.channels {
             if ["R", "G", "B"].contains(&ch.name.as_str()) {
                 ch.data.iter_mut().for_each(|v| *v *= scale);

@@ -1684,6 +1684,7 @@ fn stack_desc() -> impl Strategy<Value = StackDesc> {
                     t_term,
                     compensation,
                     calibration: smooth_top.1,
+                    base_spectrum: None,
                 }
             },
         )

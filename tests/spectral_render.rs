@@ -18,6 +18,8 @@
 //! RGB recipe does not, and its world does not trace spectrally.
 
 mod common;
+#[path = "spectral_render/measured.rs"]
+mod measured;
 
 use common::sidak_alpha;
 use glam::Vec3;

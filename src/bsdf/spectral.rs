@@ -31,6 +31,7 @@ use super::{
     TorranceSparrow, TransportMode, flush_tiny, fresnel, refract, sample_cosine_hemisphere,
 };
 use crate::color::Rgb;
+use crate::spectrum::measured::Measured;
 use crate::spectrum::wavelengths::HeroWavelengths;
 use crate::spectrum::{HeroSample, RgbSample, RgbWavelengths, Spectral, basis};
 use glam::{Vec2, Vec3};
@@ -87,17 +88,19 @@ impl Scatter<HeroSample> for Bsdf {
         lambda: &HeroWavelengths,
     ) -> HeroSample {
         match self {
-            Bsdf::Lambert(b) => lambert(b, wo, wi, lambda),
-            Bsdf::OrenNayar(b) => oren_nayar(b, wo, wi, lambda),
+            Bsdf::Lambert(b) => lambert(b, None, wo, wi, lambda),
+            Bsdf::OrenNayar(b) => oren_nayar(b, None, wo, wi, lambda),
             Bsdf::TorranceSparrow(b) => torrance_sparrow(b, wo, wi, lambda),
             Bsdf::Dielectric(b) => match b.dispersion {
                 None => HeroSample::splat(b.value(wo, wi, mode)),
                 Some(law) => rough_dispersive(b, law, wo, wi, mode, lambda),
             },
             Bsdf::SmoothDielectric(_) => HeroSample::ZERO,
-            Bsdf::Layered(b) => match bare_base(b) {
-                Some(base) => base.eval_at(wo, wi, mode, lambda),
-                None => upsample(b.eval_mode(wo, wi, mode), lambda),
+            Bsdf::Layered(b) => match (bare_base(b), b.base_spectrum) {
+                (Some(Bsdf::Lambert(l)), Some(m)) => lambert(l, Some(m), wo, wi, lambda),
+                (Some(Bsdf::OrenNayar(o)), Some(m)) => oren_nayar(o, Some(m), wo, wi, lambda),
+                (Some(base), _) => base.eval_at(wo, wi, mode, lambda),
+                (None, _) => upsample(b.eval_mode(wo, wi, mode), lambda),
             },
         }
     }
@@ -125,6 +128,18 @@ impl Scatter<HeroSample> for Bsdf {
                 }
             },
             Bsdf::Layered(b) => match bare_base(b) {
+                Some(base @ (Bsdf::Lambert(_) | Bsdf::OrenNayar(_)))
+                    if b.base_spectrum.is_some() =>
+                {
+                    // A measured diffuse base: cosine-sampled as the RGB model does, valued per
+                    // wavelength from its spectrum.
+                    if wo.z <= 0.0 {
+                        return None;
+                    }
+                    let wi = sample_cosine_hemisphere(u)?;
+                    let f = self.eval_at(wo, wi, mode, lambda);
+                    diffuse(wi, f, Bxdf::<RgbSample>::pdf(base, wo, wi))
+                }
                 Some(base) => base.sample_at(wo, uc, u, mode, lambda),
                 None => {
                     let s = b.sample_mode(wo, uc, u, mode)?;
@@ -255,19 +270,41 @@ fn recolour(s: BsdfSample, f: HeroSample) -> Option<BsdfSample<HeroSample>> {
     })
 }
 
-fn lambert(b: &Lambert, wo: Vec3, wi: Vec3, lambda: &HeroWavelengths) -> HeroSample {
+/// A diffuse albedo at the wavelengths: the measured spectrum where the recipe gave one (read
+/// exactly per wavelength), else the RGB albedo as a smooth reflectance spectrum.
+#[inline]
+fn albedo_at(rgb: RgbSample, measured: Option<&Measured>, lambda: &HeroWavelengths) -> HeroSample {
+    match measured {
+        Some(m) => HeroSample(lambda.lambda.map(|l| m.at(l))),
+        None => HeroSample::from_reflectance(Rgb::from(rgb), lambda),
+    }
+}
+
+fn lambert(
+    b: &Lambert,
+    measured: Option<&Measured>,
+    wo: Vec3,
+    wi: Vec3,
+    lambda: &HeroWavelengths,
+) -> HeroSample {
     if wo.z <= 0.0 || wi.z <= 0.0 {
         return HeroSample::ZERO;
     }
-    HeroSample::from_reflectance(Rgb::from(b.albedo), lambda) * FRAC_1_PI
+    albedo_at(b.albedo, measured, lambda) * FRAC_1_PI
 }
 
-fn oren_nayar(b: &OrenNayar, wo: Vec3, wi: Vec3, lambda: &HeroWavelengths) -> HeroSample {
+fn oren_nayar(
+    b: &OrenNayar,
+    measured: Option<&Measured>,
+    wo: Vec3,
+    wi: Vec3,
+    lambda: &HeroWavelengths,
+) -> HeroSample {
     if wo.z <= 0.0 || wi.z <= 0.0 {
         return HeroSample::ZERO;
     }
     let (direct, inter) = b.factors(wo, wi);
-    let f = HeroSample::from_reflectance(Rgb::from(b.albedo), lambda)
+    let f = albedo_at(b.albedo, measured, lambda)
         .map(|r| (r * FRAC_1_PI * (direct + r * inter)).max(0.0));
     if f.is_valid() { f } else { HeroSample::ZERO }
 }

@@ -24,6 +24,7 @@
 
 use super::color::ColorDesc;
 use super::platelets::PlateletsDesc;
+use super::spectrum::SpectrumDesc;
 use crate::bsdf::dispersion::{Ior, LAMBDA_D};
 use crate::bsdf::{Distribution, Masking};
 use crate::color::Rgb;
@@ -64,8 +65,18 @@ fn scattering<'de, D: Deserializer<'de>>(d: D) -> Result<(f32, f32, f32), D::Err
 }
 
 /// A transmittance colour: linear, each channel 0 <.. 1.
+/// The least transmittance a measured body colour is read as (a zero would be infinite
+/// absorption): `σa ≤ −ln(10⁻⁶)/distance ≈ 13.8/distance`.
+pub const MIN_TRANSMITTANCE: f32 = 1e-6;
+
 fn transmittance<'de, D: Deserializer<'de>>(d: D) -> Result<Option<ColorDesc>, D::Error> {
     let c = ColorDesc::deserialize(d)?;
+    if let Some(m) = c.measured(1.0) {
+        // A measured colour: its values within 0 ..= 1 (checked here), read per wavelength.
+        return m.map(|_| Some(c)).map_err(|e| {
+            serde::de::Error::custom(format!("medium.colour: {e}: the share of light left"))
+        });
+    }
     let rgb = c.to_rgb().map_err(serde::de::Error::custom)?;
     if rgb.0.iter().all(|&v| v > 0.0 && v <= 1.0) {
         Ok(Some(c))
@@ -166,13 +177,14 @@ pub struct MediumDesc {
     #[serde(default)]
     pub phase: PhaseDesc,
     /// A measured absorption spectrum: `(wavelength nm, σa per object unit)` points, wavelengths
-    /// increasing in 200 ..= 2000, values 0 ..= 1e4, 2 ..= 4096 points. Not with `absorption`
-    /// or `colour`. Turns spectral transport on; RGB renders use its projection.
+    /// increasing in 200 ..= 2000, values 0 ..= 1e4, 2 ..= 4096 points, inline or a CSV file
+    /// (`"file.csv"` or `(file: "file.csv", scale: s)`, [`super::spectrum`]). Not with
+    /// `absorption` or `colour`. Turns spectral transport on; RGB renders use its projection.
     #[serde(default)]
-    pub absorption_spectrum: Option<Vec<(f32, f32)>>,
+    pub absorption_spectrum: Option<SpectrumDesc>,
     /// A measured scattering spectrum, as `absorption_spectrum` (σs). Not with `scattering`.
     #[serde(default)]
-    pub scattering_spectrum: Option<Vec<(f32, f32)>>,
+    pub scattering_spectrum: Option<SpectrumDesc>,
 }
 
 /// A phase function.
@@ -320,16 +332,22 @@ impl MediumDesc {
     /// The coefficients per object unit, with the measured spectra where given, or what is
     /// wrong.
     pub fn measured_coefficients(&self) -> Result<Coefficients, String> {
-        let spectrum = |what: &str, pts: &Option<Vec<(f32, f32)>>| {
+        let spectrum = |what: &str, pts: &Option<SpectrumDesc>| {
             pts.as_ref()
                 .map(|p| {
-                    Measured::from_points(p, SIGMA_MAX).map_err(|e| format!("medium.{what}: {e}"))
+                    Measured::from_points(&p.points, SIGMA_MAX)
+                        .map_err(|e| format!("medium.{what}: {e}"))
                 })
                 .transpose()
         };
-        let a = spectrum("absorption_spectrum", &self.absorption_spectrum)?;
+        let mut a = spectrum("absorption_spectrum", &self.absorption_spectrum)?;
+        if let Some(m) = self.colour_spectrum()? {
+            a = Some(m);
+        }
         let s = spectrum("scattering_spectrum", &self.scattering_spectrum)?;
-        if a.is_some() && (self.absorption.is_some() || self.colour.is_some()) {
+        if self.absorption_spectrum.is_some()
+            && (self.absorption.is_some() || self.colour.is_some())
+        {
             return Err(
                 "medium: give the absorption as one of `absorption`, `colour` and `distance`, or \
                  `absorption_spectrum`"
@@ -356,14 +374,34 @@ impl MediumDesc {
         })
     }
 
-    /// `σa` and `σs` per object unit (RGB, ignoring measured spectra), or what is wrong.
+    /// The absorption spectrum of a measured `colour` after `distance`: `σa(λ) =
+    /// −ln(colour(λ))/distance` per wavelength (a colour value below [`MIN_TRANSMITTANCE`] counts
+    /// as that: at most `13.8/distance`); `None` when the colour is not a spectrum.
+    fn colour_spectrum(&self) -> Result<Option<Measured>, String> {
+        let (Some(c), Some(d)) = (&self.colour, self.distance) else {
+            return Ok(None);
+        };
+        let Some(m) = c.measured(1.0) else {
+            return Ok(None);
+        };
+        let m = m.map_err(|e| format!("medium.colour: {e}"))?;
+        Ok(Some(m.map(|t| {
+            (-t.max(MIN_TRANSMITTANCE).ln() / d).clamp(0.0, SIGMA_MAX)
+        })))
+    }
+
+    /// `σa` and `σs` per object unit (RGB, measured spectra as their projections), or what is
+    /// wrong.
     pub fn coefficients(&self) -> Result<(Rgb, Rgb), String> {
         let sigma_a = match (&self.absorption, &self.colour, self.distance) {
             (Some(a), None, None) => Rgb::new(a.0, a.1, a.2),
-            (None, Some(c), Some(d)) => {
-                let c = c.to_rgb()?;
-                Rgb(c.0.map(|v| (-v.ln() / d).max(0.0)))
-            }
+            (None, Some(c), Some(d)) => match self.colour_spectrum()? {
+                Some(m) => m.to_rgb(),
+                None => {
+                    let c = c.to_rgb()?;
+                    Rgb(c.0.map(|v| (-v.ln() / d).max(0.0)))
+                }
+            },
             (None, None, None) => Rgb::ZERO,
             (Some(_), Some(_), _) | (Some(_), _, Some(_)) => {
                 return Err(

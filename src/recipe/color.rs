@@ -1,8 +1,15 @@
 //! Colour literals in recipes: `Rgb(r, g, b)` (linear Rec.709), `Srgb(r, g, b)` (sRGB-encoded,
-//! 0 … 1), `Hex("#rrggbb")` (sRGB-encoded) and `Gray(v)` (linear).
+//! 0 … 1), `Hex("#rrggbb")` (sRGB-encoded), `Gray(v)` (linear) and `Spectrum(…)`, a measured
+//! reflectance or transmittance spectrum ([`super::spectrum`]; issue 19).
 
+use super::spectrum::SpectrumDesc;
 use crate::color::Rgb;
+use crate::spectrum::measured::Measured;
 use serde::{Deserialize, Serialize};
+
+/// Largest value a colour's spectrum may have (a reflectance or transmittance is further limited
+/// to 1 where the recipe uses it).
+pub const SPECTRUM_MAX: f32 = 1e4;
 
 /// A colour as written in a recipe.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -15,9 +22,30 @@ pub enum ColorDesc {
     Hex(String),
     /// The same linear value in every channel.
     Gray(f32),
+    /// A spectrum: `(nm, value)` points or a CSV file ([`SpectrumDesc`]). RGB renders use its
+    /// D65-weighted linear sRGB projection ([`Measured::to_rgb`]); spectral renders read it per
+    /// wavelength where the model allows (a coat-less diffuse base, a body's colour), else they
+    /// use the projection.
+    Spectrum(SpectrumDesc),
 }
 
 impl ColorDesc {
+    /// The spectrum on the 10 nm grid when the colour is a `Spectrum` (values checked within
+    /// `0 ..= max`), else `None`.
+    pub fn measured(&self, max: f32) -> Option<Result<Measured, String>> {
+        match self {
+            ColorDesc::Spectrum(s) => {
+                Some(
+                    Measured::from_points(&s.points, max).map_err(|e| match &s.file {
+                        Some(f) => format!("Spectrum({f:?}): {e}"),
+                        None => format!("Spectrum: {e}"),
+                    }),
+                )
+            }
+            _ => None,
+        }
+    }
+
     /// The linear colour, or a message saying what is wrong with the literal.
     pub fn to_rgb(&self) -> Result<Rgb, String> {
         let check = |v: [f32; 3]| {
@@ -57,6 +85,10 @@ impl ColorDesc {
                     _ => Err(format!("Hex(\"{s}\"): not a hexadecimal colour")),
                 }
             }
+            ColorDesc::Spectrum(_) => self
+                .measured(SPECTRUM_MAX)
+                .expect("a spectrum")
+                .map(|m| m.to_rgb()),
         }
     }
 }
@@ -73,5 +105,12 @@ mod tests {
         assert!(ColorDesc::Hex("#ff00".into()).to_rgb().is_err());
         assert!(ColorDesc::Srgb(1.2, 0.0, 0.0).to_rgb().is_err());
         assert!(ColorDesc::Rgb(f32::NAN, 0.0, 0.0).to_rgb().is_err());
+        // A flat spectrum is its grey; a bad one says what is wrong.
+        let flat = ColorDesc::Spectrum(SpectrumDesc::inline(vec![(360.0, 0.4), (830.0, 0.4)]));
+        let g = flat.to_rgb().unwrap();
+        assert!(g.0.iter().all(|&c| (c - 0.4).abs() < 1e-6), "{g:?}");
+        let bad = ColorDesc::Spectrum(SpectrumDesc::inline(vec![(500.0, 0.4), (400.0, 0.4)]));
+        assert!(bad.to_rgb().unwrap_err().contains("does not increase"));
+        assert!(flat.measured(0.3).unwrap().is_err());
     }
 }

@@ -473,6 +473,15 @@ impl Compiler<'_> {
                 format!("{element} ({file}, {:?} model)", stack.model),
             );
         }
+        // A measured albedo is read per wavelength only by a coat-less base; under coats both
+        // modes use its RGB projection (the stack's tables are per RGB channel), so it does not
+        // call for spectral transport there.
+        if stack.base_spectrum.is_some() && stack.coats.is_empty() {
+            self.effects.turn_on(
+                Effect::Spectral,
+                format!("{element} base.albedo spectrum ({file})"),
+            );
+        }
     }
 }
 

@@ -244,6 +244,9 @@ impl MaterialDesc {
                     .to_rgb()
                     .map_err(|e| format!("coats[{i}].absorption: {e}"))?,
                 (None, Some(t)) => {
+                    if let Some(m) = t.measured(1.0) {
+                        m.map_err(|e| format!("coats[{i}].tint: {e}"))?;
+                    }
                     let t = t.to_rgb().map_err(|e| format!("coats[{i}].tint: {e}"))?;
                     if !(c.thickness > 0.0) {
                         return Err(format!(
@@ -268,12 +271,23 @@ impl MaterialDesc {
                 thickness: c.thickness,
             });
         }
+        let mut base_spectrum = None;
+        let mut albedo_of = |albedo: &ColorDesc| match albedo.measured(1.0) {
+            // A measured albedo: values within 0 ..= 1 at every wavelength; its RGB projection
+            // (which a saturated spectrum can push past 1 in one channel) kept within 0 ..= 1.
+            Some(m) => {
+                let m = m.map_err(|e| format!("base.albedo: {e}"))?;
+                base_spectrum = Some(m.intern());
+                Ok(m.to_rgb().map(|v| v.min(1.0)))
+            }
+            None => albedo.to_rgb().map_err(|e| format!("base.albedo: {e}")),
+        };
         let base = match &self.base {
             BaseDesc::Lambert { albedo } => Base::Lambert {
-                albedo: albedo.to_rgb().map_err(|e| format!("base.albedo: {e}"))?,
+                albedo: albedo_of(albedo)?,
             },
             BaseDesc::OrenNayar { albedo, sigma } => Base::OrenNayar {
-                albedo: albedo.to_rgb().map_err(|e| format!("base.albedo: {e}"))?,
+                albedo: albedo_of(albedo)?,
                 sigma: *sigma,
             },
             BaseDesc::Conductor {
@@ -311,6 +325,7 @@ impl MaterialDesc {
             t_term: self.t_term,
             compensation: self.compensation,
             calibration: self.calibration,
+            base_spectrum,
         })
     }
 }

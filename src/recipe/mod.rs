@@ -19,6 +19,7 @@ mod platelet_compiler;
 pub mod platelets;
 mod resolve;
 pub mod source;
+pub mod spectrum;
 pub mod stage;
 pub mod surface;
 

@@ -162,11 +162,15 @@ where
 {
     source.check_text()?;
     check_nesting(source)?;
+    // Spectrum files are read relative to the description's folder.
+    let base = std::path::Path::new(&source.file).parent();
     let run = || {
-        super::ron_options()
-            .with_recursion_limit(RON_RECURSION_LIMIT)
-            .from_str::<T>(&source.text)
-            .map_err(|e| source.ron_error(&e))
+        super::spectrum::with_base(base, || {
+            super::ron_options()
+                .with_recursion_limit(RON_RECURSION_LIMIT)
+                .from_str::<T>(&source.text)
+                .map_err(|e| source.ron_error(&e))
+        })
     };
     std::thread::scope(|s| {
         match std::thread::Builder::new()

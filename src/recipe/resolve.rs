@@ -162,7 +162,7 @@ pub(crate) fn stage(
                         let at = at.and_then(|a| src.find_from(a, &["spectrum", ":"])).or(at);
                         src.error(at, format!("stage.lights[{i}].spectrum: {m}"))
                     };
-                    match Measured::from_points(points, 1e9) {
+                    match Measured::from_points(&points.points, 1e9) {
                         Err(m) => {
                             errors.push(fail(m));
                             continue;

@@ -75,6 +75,12 @@ pub const MAX_RADIANCE: f32 = 1e6;
 /// A colour that is emitted light: within 0 ..= [`MAX_RADIANCE`] in every channel.
 fn radiance<'de, D: Deserializer<'de>>(d: D) -> Result<ColorDesc, D::Error> {
     let c = ColorDesc::deserialize(d)?;
+    if let ColorDesc::Spectrum(_) = c {
+        return Err(serde::de::Error::custom(
+            "an emitted colour cannot be a `Spectrum(…)` (a reflectance's projection): give an \
+             RGB colour, and for a light its measured emission as `spectrum: [(nm, value), …]`",
+        ));
+    }
     match c.to_rgb() {
         Ok(s) if s.0.iter().all(|v| (0.0..=MAX_RADIANCE).contains(v)) => Ok(c),
         Ok(s) => Err(serde::de::Error::custom(format!(
@@ -88,6 +94,12 @@ fn radiance<'de, D: Deserializer<'de>>(d: D) -> Result<ColorDesc, D::Error> {
 /// A reflectance: finite and within 0 ..= 1 in every channel.
 fn albedo<'de, D: Deserializer<'de>>(d: D) -> Result<ColorDesc, D::Error> {
     let c = ColorDesc::deserialize(d)?;
+    if let ColorDesc::Spectrum(_) = c {
+        return Err(serde::de::Error::custom(
+            "the floor's albedo cannot be a `Spectrum(…)`: give an RGB colour (measured albedos \
+             belong to a material's base)",
+        ));
+    }
     match c.to_rgb() {
         Ok(s) if s.0.iter().all(|v| (0.0..=1.0).contains(v)) => Ok(c),
         Ok(s) => Err(serde::de::Error::custom(format!(
@@ -333,11 +345,11 @@ pub enum LightDesc {
         /// Emit from both faces (default false: only towards `target`).
         #[serde(default)]
         two_sided: bool,
-        /// A measured relative spectral power distribution, `[(nm, power), …]`: the light emits
-        /// this spectrum scaled to the luminance of `radiance × intensity` (its colour replaces
-        /// `radiance`'s). Turns spectral transport on.
+        /// A measured relative spectral power distribution, `[(nm, power), …]` or a CSV file
+        /// ([`super::spectrum`]): the light emits this spectrum scaled to the luminance of
+        /// `radiance × intensity` (its colour replaces `radiance`'s). Turns spectral transport on.
         #[serde(default)]
-        spectrum: Option<Vec<(f32, f32)>>,
+        spectrum: Option<super::spectrum::SpectrumDesc>,
     },
     /// A disc.
     Disc {
@@ -361,7 +373,7 @@ pub enum LightDesc {
         two_sided: bool,
         /// A measured relative spectral power distribution (as for `Rect`).
         #[serde(default)]
-        spectrum: Option<Vec<(f32, f32)>>,
+        spectrum: Option<super::spectrum::SpectrumDesc>,
     },
 }
 

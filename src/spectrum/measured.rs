@@ -81,6 +81,13 @@ impl Measured {
         Ok(Measured { values })
     }
 
+    /// `f` applied to every grid value.
+    pub fn map(&self, f: impl Fn(f32) -> f32) -> Measured {
+        Measured {
+            values: self.values.map(f),
+        }
+    }
+
     /// The same spectrum times `s` (a unit change).
     pub fn scaled(&self, s: f32) -> Measured {
         Measured {
@@ -114,6 +121,21 @@ impl Measured {
         let xyz = super::cie::spectrum_to_xyz(|l| self.at(l));
         let c = super::cie::xyz_to_linear_srgb(xyz);
         Rgb::new(c.x.max(0.0), c.y.max(0.0), c.z.max(0.0))
+    }
+
+    /// This spectrum with a `'static` lifetime, for runtime records that stay `Copy` (a stack's
+    /// measured albedo). Equal spectra share one allocation, so memory grows with the number of
+    /// distinct spectra a process loads, not with how often they are loaded.
+    pub fn intern(self) -> &'static Measured {
+        use std::sync::Mutex;
+        static INTERNED: Mutex<Vec<&'static Measured>> = Mutex::new(Vec::new());
+        let mut list = INTERNED.lock().unwrap_or_else(|p| p.into_inner());
+        if let Some(m) = list.iter().find(|m| ***m == self) {
+            return m;
+        }
+        let m: &'static Measured = Box::leak(Box::new(self));
+        list.push(m);
+        m
     }
 
     /// The linear Rec.709 triple an RGB render uses for this coefficient spectrum (module docs).

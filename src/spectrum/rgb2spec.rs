@@ -22,7 +22,8 @@
 //! solution is exact), its top row then every column, each fit starting from its neighbour's
 //! solution; then every `(x, y)` is continued from the middle brightness out to both ends of the
 //! `z` scale. A fit that does not converge from its neighbour retries through intermediate
-//! targets. Every entry converges to ΔE76 < 10⁻⁶ ([`max_fit_error`]). A lookup interpolates the
+//! targets. The table is kept on disk between runs ([`cache`]: `$LAPIDARY_CACHE_DIR`, else the
+//! user's cache folder; keyed by a hash of these sources and data). Every entry converges to ΔE76 < 10⁻⁶ ([`max_fit_error`]). A lookup interpolates the
 //! coefficients trilinearly ([`reflectance`]).
 //!
 //! **Black, white, dark** (the pitfalls of pbrt-v4 pull request #62 and issue #82). Greys are
@@ -45,6 +46,7 @@
 use super::cie::{self, CMF_SAMPLES, LAMBDA_MIN};
 use std::sync::OnceLock;
 
+mod cache;
 pub mod fit;
 mod sigmoid;
 
@@ -86,7 +88,13 @@ fn table() -> &'static Table {
     static TABLE: OnceLock<Table> = OnceLock::new();
     TABLE.get_or_init(|| {
         let z = fit::z_scale(RES, f64::from(Z_DARK));
-        let (coeffs, max_fit_error) = fit::build_table(RES, &z);
+        // Read from the on-disk cache when a valid one is there ([`cache`]), else built and
+        // stored for the next run.
+        let (coeffs, max_fit_error) = cache::load(3 * RES * RES * RES).unwrap_or_else(|| {
+            let (coeffs, err) = fit::build_table(RES, &z);
+            cache::store(&coeffs, err);
+            (coeffs, err)
+        });
         Table {
             z: z.iter().map(|&v| v as f32).collect(),
             coeffs,

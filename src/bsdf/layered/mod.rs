@@ -161,6 +161,10 @@ pub struct StackDesc {
     /// The Corrected model's albedo calibration to the adding solution ([`calibrate`]); on by
     /// default, off to measure what it buys (`tradeoff` knob `calibration`).
     pub calibration: bool,
+    /// A measured albedo spectrum of a Lambert or Oren–Nayar base (the `albedo` above is its RGB
+    /// projection). Spectral renders read it per wavelength when the stack has no coats; a coated
+    /// stack's spectral value is its RGB value as a spectrum ([`crate::bsdf::spectral`]).
+    pub base_spectrum: Option<&'static crate::spectrum::measured::Measured>,
 }
 
 impl StackDesc {
@@ -177,6 +181,7 @@ impl StackDesc {
             t_term: None,
             compensation: true,
             calibration: true,
+            base_spectrum: None,
         }
     }
     /// The same stack under another model.
@@ -302,6 +307,8 @@ pub struct LayeredBsdf {
     pub(crate) fresnel: FresnelMode,
     pub(crate) distribution: Distribution,
     pub(crate) masking: Masking,
+    /// A diffuse base's measured albedo spectrum ([`StackDesc::base_spectrum`]).
+    pub(crate) base_spectrum: Option<&'static crate::spectrum::measured::Measured>,
 }
 
 /// Roughness (degrees) of the placeholder micro-facet lobes a smooth coat carries.
@@ -399,6 +406,10 @@ impl LayeredBsdf {
             fresnel: desc.fresnel,
             distribution: desc.distribution,
             masking: desc.masking,
+            base_spectrum: match desc.base {
+                Base::Lambert { .. } | Base::OrenNayar { .. } => desc.base_spectrum,
+                Base::Conductor { .. } => None,
+            },
         };
         for l in (0..stack.levels.len()).rev() {
             corrected::build_tables(&mut stack, l, TABLE_GRID);

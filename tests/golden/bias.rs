@@ -1,6 +1,6 @@
 //! `compare` detects a bias, not only noise (issue 14), on the golden scenes: the references in
-//! `tests/refs/` against test renders made as `tests/golden.rs` makes them (96×96, 256 spp,
-//! independent sampler, seed 7).
+//! `tests/refs/` against the golden test renders of `tests/golden.rs` (96×96, 256 spp,
+//! independent sampler, seed 7), which this module shares rather than rendering them again.
 //!
 //! - a uniform 2 % shift of every scene fails;
 //! - a 5 % shift of one material's pixels (selected by `material.Y`) fails wherever the noise
@@ -12,76 +12,16 @@
 //!   α = 0.01: the number of failures `f` of `n` pairs must satisfy `f ≤ k` with `k` the
 //!   smallest count for which `P(Bin(n, 0.01) > k) < 0.001`. CI runs 30 pairs at 48×48 and
 //!   128 spp; the full 200 pairs at the golden settings are `#[ignore]`d:
-//!   `cargo test --release --test compare_bias -- --ignored --nocapture`.
+//!   `cargo test --release --test golden -- --ignored --nocapture`.
 
+use super::{golden_renders, recipe_of, reference, render_text, scenes};
 use lapidary::image::ExrImage;
 use lapidary::image::compare::{AGGREGATE_ALPHA, Comparison, compare};
-use lapidary::image::read_exr;
-use lapidary::recipe::GemRecipe;
-use lapidary::render::{Control, Metadata, World, exr_image, render_scene};
-use lapidary::sampler::SamplerKind;
-use std::path::{Path, PathBuf};
-use std::sync::OnceLock;
-
-/// The golden scenes: every reference in `tests/refs/`, sorted.
-fn scenes() -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir("tests/refs")
-        .expect("tests/refs")
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|e| e == "exr"))
-        .map(|p| p.file_stem().unwrap().to_string_lossy().into_owned())
-        .collect();
-    names.sort();
-    assert!(names.len() >= 10, "{names:?}");
-    names
-}
-
-/// The recipe a reference belongs to.
-fn recipe_of(name: &str) -> PathBuf {
-    let gem = Path::new("gems").join(format!("{name}.ron"));
-    if gem.exists() {
-        gem
-    } else {
-        Path::new("tests/scenes").join(format!("{name}.ron"))
-    }
-}
-
-fn reference(name: &str) -> ExrImage {
-    read_exr(&Path::new("tests/refs").join(format!("{name}.exr"))).unwrap_or_else(|e| panic!("{e}"))
-}
-
-/// Renders `text` (recipe source, read as if it were the file `recipe`) at `size`² and `spp`
-/// with the independent sampler and `seed`, as the golden tests do.
-fn render_text(recipe: &Path, text: &str, size: u32, spp: u32, seed: u64) -> ExrImage {
-    let file = recipe.to_str().unwrap();
-    let gem = GemRecipe::parse(file, text).unwrap_or_else(|e| panic!("{e}"));
-    let mut scene = gem.compile().unwrap_or_else(|e| panic!("{e}"));
-    let r = &mut scene.stage.render;
-    (r.width, r.height, r.spp, r.seed) = (size, size, spp, seed);
-    r.sampler = SamplerKind::Independent;
-    let world = World::new(&scene).expect("world");
-    let rendered = render_scene(&world, &scene, &Control::default());
-    exr_image(&rendered, &Metadata::of(file, &scene))
-}
 
 fn render(name: &str, size: u32, spp: u32, seed: u64) -> ExrImage {
     let recipe = recipe_of(name);
     let text = std::fs::read_to_string(&recipe).unwrap();
     render_text(&recipe, &text, size, spp, seed)
-}
-
-/// Every golden scene at the golden settings with seed 7, rendered once for all tests.
-fn golden_renders() -> &'static [(String, ExrImage)] {
-    static RENDERS: OnceLock<Vec<(String, ExrImage)>> = OnceLock::new();
-    RENDERS.get_or_init(|| {
-        scenes()
-            .into_iter()
-            .map(|n| {
-                let img = render(&n, 96, 256, 7);
-                (n, img)
-            })
-            .collect()
-    })
 }
 
 /// `img` with R, G, B multiplied by `gain` where `select(pixel index)` holds.
