@@ -8,6 +8,13 @@
 //! Times are the process's CPU time on 64-bit Linux (benches/common/clock.rs). Run with
 //! `cargo bench --bench spectral` (about three minutes); a filter narrows it, e.g.
 //! `cargo bench --bench spectral -- sunstone`. No number here is asserted anywhere.
+//!
+//! **Paired ratios.** On a shared VM the machine's speed drifts by 10–20 % between criterion's
+//! groups, more than the effect measured. `LAPIDARY_BENCH_PAIRS=N cargo bench --bench spectral`
+//! instead renders each gem N times in each variant, alternating (RGB first, then spectral first,
+//! …), and prints per gem the median of the N per-pair ratios spectral / RGB with its quartiles:
+//! drift slower than one pair cancels out. `LAPIDARY_BENCH_GEMS=sunstone,milky` keeps the gems
+//! whose names contain one of the words.
 
 use criterion::Criterion;
 use lapidary::recipe::GemRecipe;
@@ -61,6 +68,55 @@ fn run(world: &World, scene: &Scene) -> Film {
     .film
 }
 
+/// The paired measurement (module docs): `pairs` alternating renders per gem and variant.
+fn paired(gems: &[std::path::PathBuf], pairs: usize) {
+    use criterion::measurement::Measurement;
+    let clock = clock::measurement();
+    println!(
+        "| gem | RGB (median) | spectral (median) | ratio: median of {pairs} pairs | quartiles |"
+    );
+    println!("|---|---:|---:|---:|---|");
+    for path in gems {
+        let name = path.file_stem().unwrap().to_string_lossy().to_string();
+        let setups: Vec<(Scene, World)> = [false, true]
+            .iter()
+            .map(|&spectral| {
+                let scene = gem(path, spectral);
+                let world = World::new(&scene).expect("world builds");
+                (scene, world)
+            })
+            .collect();
+        for (scene, world) in &setups {
+            black_box(run(world, scene)); // warm
+        }
+        let (mut ratios, mut times) = (Vec::new(), [Vec::new(), Vec::new()]);
+        for k in 0..pairs {
+            let order = if k % 2 == 0 { [0, 1] } else { [1, 0] };
+            let mut t = [0.0f64; 2];
+            for v in order {
+                let (scene, world) = &setups[v];
+                let start = clock.start();
+                black_box(run(world, scene));
+                t[v] = clock.end(start).as_secs_f64();
+                times[v].push(t[v]);
+            }
+            ratios.push(t[1] / t[0]);
+        }
+        let q = |v: &mut Vec<f64>, p: f64| {
+            v.sort_by(f64::total_cmp);
+            v[((v.len() - 1) as f64 * p).round() as usize]
+        };
+        println!(
+            "| {name} | {:.1} ms | {:.1} ms | {:.3} | {:.3}–{:.3} |",
+            1e3 * q(&mut times[0], 0.5),
+            1e3 * q(&mut times[1], 0.5),
+            q(&mut ratios, 0.5),
+            q(&mut ratios, 0.25),
+            q(&mut ratios, 0.75)
+        );
+    }
+}
+
 fn bench(c: &mut Criterion<Clock>) {
     clock::select(clock::Kind::Process);
     lapidary::spectrum::rgb2spec::warm_up();
@@ -72,6 +128,24 @@ fn bench(c: &mut Criterion<Clock>) {
         .filter(|p| p.extension().is_some_and(|e| e == "ron"))
         .collect();
     gems.sort();
+    if let Some(pairs) = std::env::var("LAPIDARY_BENCH_PAIRS")
+        .ok()
+        .and_then(|s| s.parse::<usize>().ok())
+        .filter(|&n| (1..=1000).contains(&n))
+    {
+        let filter: Vec<String> = std::env::var("LAPIDARY_BENCH_GEMS")
+            .unwrap_or_default()
+            .split(',')
+            .filter(|s| !s.is_empty())
+            .map(str::to_string)
+            .collect();
+        gems.retain(|p| {
+            let n = p.file_stem().unwrap().to_string_lossy();
+            filter.is_empty() || filter.iter().any(|f| n.contains(f.as_str()))
+        });
+        paired(&gems, pairs);
+        return;
+    }
     for path in gems {
         let name = path.file_stem().unwrap().to_string_lossy().to_string();
         let mut group = c.benchmark_group(format!("spectral/{name}"));

@@ -124,6 +124,16 @@ thread_local! {
         const { std::cell::RefCell::new([([0; 8], HeroSample([0.0; N])); 1 << MEMO_BITS]) };
 }
 
+/// The value of a grey colour (equal, finite, non-negative channels; clamped as
+/// [`rgb2spec::unbounded`] clamps), whose spectrum is flat: the conversions return it without
+/// the table or the memo, exactly the flat spectrum (`Sigmoid::flat` would round through the
+/// sigmoid's inverse).
+#[inline]
+fn grey(c: Rgb) -> Option<f32> {
+    let [r, g, b] = c.0;
+    (r == g && g == b && r >= 0.0 && r.is_finite()).then(|| r.min(f32::MAX / 4.0))
+}
+
 /// `compute()` through the memo.
 #[inline]
 fn memo(
@@ -171,6 +181,10 @@ impl Spectral for HeroSample {
     }
 
     fn from_reflectance(c: Rgb, lambda: &HeroWavelengths) -> Self {
+        // A grey is exactly flat (the studio's floor, grey albedos): no lookup, no memo.
+        if let Some(v) = grey(c) {
+            return HeroSample::splat(v.min(1.0));
+        }
         memo(Kind::Reflectance, c, lambda, || {
             let s = rgb2spec::reflectance(c.0);
             HeroSample::at(lambda, |l| s.eval(l))
@@ -178,6 +192,9 @@ impl Spectral for HeroSample {
     }
 
     fn from_unbounded(c: Rgb, lambda: &HeroWavelengths) -> Self {
+        if let Some(v) = grey(c) {
+            return HeroSample::splat(v);
+        }
         memo(Kind::Unbounded, c, lambda, || {
             let (scale, s) = rgb2spec::unbounded(c.0);
             HeroSample::at(lambda, |l| scale * s.eval(l))
@@ -185,6 +202,10 @@ impl Spectral for HeroSample {
     }
 
     fn from_illuminant(c: Rgb, lambda: &HeroWavelengths) -> Self {
+        // A grey light or sky is D65 scaled (the studio's lights and sky gradient).
+        if let Some(v) = grey(c) {
+            return HeroSample(lambda.illuminant.map(|d| v * d));
+        }
         memo(Kind::Illuminant, c, lambda, || {
             let (scale, s) = rgb2spec::illuminant(c.0);
             HeroSample(std::array::from_fn(|i| {
