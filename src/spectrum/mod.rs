@@ -25,6 +25,7 @@
 
 pub mod basis;
 pub mod cie;
+pub mod fluorescence;
 pub mod hero;
 pub mod measured;
 pub mod rgb;
