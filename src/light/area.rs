@@ -49,7 +49,7 @@ pub struct Area {
     radiance: Rgb,
     two_sided: bool,
     area: f32,
-    spectrum: Option<Measured>,
+    spectrum: Option<&'static Measured>,
 }
 
 /// The spherical rectangle a rectangle subtends from a point `o` (Ureña et al. 2013, §3), in
@@ -114,14 +114,14 @@ impl Area {
             radiance,
             two_sided: light.two_sided,
             area: if ok { area } else { 0.0 },
-            spectrum: light.spectrum,
+            spectrum: light.spectrum.map(Measured::intern),
         }
     }
 
     /// The light's measured emission spectrum, if the recipe gave one (its RGB colour is what
     /// [`Area::emitted`] returns).
     pub fn spectrum(&self) -> Option<&Measured> {
-        self.spectrum.as_ref()
+        self.spectrum
     }
 
     /// Emitted radiance `rgb` (what [`Area::emitted`] or a light sample returned) at the path's
@@ -129,7 +129,7 @@ impl Area {
     /// that does not emit), else the colour's illuminant spectrum.
     #[inline]
     pub fn emission<S: Spectral>(&self, rgb: Rgb, lambda: &S::Wavelengths) -> S {
-        match &self.spectrum {
+        match self.spectrum {
             Some(m) if rgb != Rgb::ZERO => S::from_measured(m, rgb, lambda),
             _ => S::from_illuminant(rgb, lambda),
         }
@@ -164,10 +164,12 @@ impl Area {
     }
 
     /// The nearest hit `t ∈ (0, t_max)` of `ray` with the light's surface, from either face.
+    #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<f32> {
         self.hit(ray, t_max, 0.0)
     }
 
+    #[inline]
     fn hit(&self, ray: &Ray, t_max: f32, slack: f32) -> Option<f32> {
         if !(self.area > 0.0) {
             return None;

@@ -11,7 +11,7 @@ use crate::spectrum::measured::Measured;
 /// A coefficient at the wavelengths: the measured spectrum where there is one, else the RGB
 /// value's spectrum.
 #[inline]
-fn coefficient<S: Spectral>(rgb: Rgb, measured: &Option<Measured>, lambda: &S::Wavelengths) -> S {
+fn coefficient<S: Spectral>(rgb: Rgb, measured: Option<&Measured>, lambda: &S::Wavelengths) -> S {
     match measured {
         Some(m) => S::from_measured(m, rgb, lambda),
         None => S::from_unbounded(rgb, lambda),
@@ -28,10 +28,12 @@ pub struct Homogeneous {
     /// The phase function at scattering points.
     pub phase: HenyeyGreenstein,
     /// A measured absorption spectrum, per world unit (`sigma_a` is then its RGB projection):
-    /// spectral paths read it at their wavelengths.
-    pub sigma_a_measured: Option<Measured>,
+    /// spectral paths read it at their wavelengths. Interned ([`Measured::intern`]): a reference
+    /// keeps the medium small (an inline spectrum made it 400 bytes larger and RGB renders
+    /// through media measurably slower).
+    pub sigma_a_measured: Option<&'static Measured>,
     /// A measured scattering spectrum, per world unit (`sigma_s` is its RGB projection).
-    pub sigma_s_measured: Option<Measured>,
+    pub sigma_s_measured: Option<&'static Measured>,
 }
 
 /// `exp(−σ t)` per channel, exactly 1 where `σ = 0` (also for `t = ∞`).
@@ -73,8 +75,8 @@ impl Homogeneous {
     /// See [`super::Medium::transmittance`].
     #[inline]
     pub fn transmittance<S: Spectral>(&self, t: f32, lambda: &S::Wavelengths) -> S {
-        let sigma_t = coefficient::<S>(self.sigma_a, &self.sigma_a_measured, lambda)
-            + coefficient::<S>(self.sigma_s, &self.sigma_s_measured, lambda);
+        let sigma_t = coefficient::<S>(self.sigma_a, self.sigma_a_measured, lambda)
+            + coefficient::<S>(self.sigma_s, self.sigma_s_measured, lambda);
         transmittance(sigma_t, t)
     }
 
@@ -87,7 +89,7 @@ impl Homogeneous {
         u: f32,
         lambda: &S::Wavelengths,
     ) -> FreeFlight<S> {
-        let sigma_a = coefficient::<S>(self.sigma_a, &self.sigma_a_measured, lambda);
+        let sigma_a = coefficient::<S>(self.sigma_a, self.sigma_a_measured, lambda);
         if !self.scatters() {
             // Nothing is sampled: the same (deterministic) event for every channel.
             return FreeFlight::Pass {
@@ -95,7 +97,7 @@ impl Homogeneous {
                 pdf: S::ONE,
             };
         }
-        let sigma_s = coefficient::<S>(self.sigma_s, &self.sigma_s_measured, lambda);
+        let sigma_s = coefficient::<S>(self.sigma_s, self.sigma_s_measured, lambda);
         let sigma_t = sigma_a + sigma_s;
         let st = sigma_t.channel(hero);
         let t = if st > 0.0 {
@@ -217,7 +219,7 @@ mod tests {
         .unwrap();
         let h = Homogeneous {
             sigma_a: m.to_rgb(),
-            sigma_a_measured: Some(m),
+            sigma_a_measured: Some(m.intern()),
             ..medium([0.0; 3], [0.0; 3])
         };
         let lambda = HeroWavelengths::sample(0.41);

@@ -91,8 +91,8 @@ impl Body {
                     sigma_a: m.sigma_a * (1.0 / scale),
                     sigma_s: m.sigma_s * (1.0 / scale),
                     phase: HenyeyGreenstein::new(m.g),
-                    sigma_a_measured: m.sigma_a_measured.map(|s| s.scaled(1.0 / scale)),
-                    sigma_s_measured: m.sigma_s_measured.map(|s| s.scaled(1.0 / scale)),
+                    sigma_a_measured: m.sigma_a_measured.map(|s| s.scaled(1.0 / scale).intern()),
+                    sigma_s_measured: m.sigma_s_measured.map(|s| s.scaled(1.0 / scale).intern()),
                 };
                 Medium::Homogeneous(if scattering {
                     h
