@@ -34,14 +34,7 @@ impl ColorDesc {
     /// `0 ..= max`), else `None`.
     pub fn measured(&self, max: f32) -> Option<Result<Measured, String>> {
         match self {
-            ColorDesc::Spectrum(s) => {
-                Some(
-                    Measured::from_points(&s.points, max).map_err(|e| match &s.file {
-                        Some(f) => format!("Spectrum({f:?}): {e}"),
-                        None => format!("Spectrum: {e}"),
-                    }),
-                )
-            }
+            ColorDesc::Spectrum(s) => Some(grid(s, max)),
             _ => None,
         }
     }
@@ -85,12 +78,17 @@ impl ColorDesc {
                     _ => Err(format!("Hex(\"{s}\"): not a hexadecimal colour")),
                 }
             }
-            ColorDesc::Spectrum(_) => self
-                .measured(SPECTRUM_MAX)
-                .expect("a spectrum")
-                .map(|m| m.to_rgb()),
+            ColorDesc::Spectrum(s) => grid(s, SPECTRUM_MAX).map(|m| m.to_rgb()),
         }
     }
+}
+
+/// `s` on the 10 nm grid, its values checked within `0 ..= max`; errors name the file if any.
+fn grid(s: &SpectrumDesc, max: f32) -> Result<Measured, String> {
+    Measured::from_points(&s.points, max).map_err(|e| match &s.file {
+        Some(f) => format!("Spectrum({f:?}): {e}"),
+        None => format!("Spectrum: {e}"),
+    })
 }
 
 #[cfg(test)]

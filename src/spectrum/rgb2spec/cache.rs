@@ -31,8 +31,13 @@ fn fnv(bytes: &[u8], mut h: u64) -> u64 {
 }
 const FNV_START: u64 = 0xcbf2_9ce4_8422_2325;
 
-/// The hash of everything the table is computed from.
+/// The hash of everything the table is computed from (hashed once per process).
 fn key() -> u64 {
+    static KEY: std::sync::OnceLock<u64> = std::sync::OnceLock::new();
+    *KEY.get_or_init(compute_key)
+}
+
+fn compute_key() -> u64 {
     let parts: [&[u8]; 7] = [
         include_str!("fit.rs").as_bytes(),
         include_str!("sigmoid.rs").as_bytes(),
