@@ -1685,6 +1685,7 @@ fn stack_desc() -> impl Strategy<Value = StackDesc> {
                     compensation,
                     calibration: smooth_top.1,
                     base_spectrum: None,
+                    fluorescence: None,
                 }
             },
         )

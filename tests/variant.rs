@@ -75,6 +75,20 @@ impl Div<f32> for Grey4 {
 }
 
 impl Spectral for Grey4 {
+    /// A grey variant cannot move light between wavelengths: no re-radiation reaches it.
+    fn fluoresce(
+        &mut self,
+        _lambda: &mut Self::Wavelengths,
+        _colorant: &lapidary::spectrum::fluorescence::Fluorescence,
+        _lines: &[lapidary::spectrum::line::Line],
+        _u: glam::Vec2,
+    ) -> Option<[[f32; 3]; 3]> {
+        *self = Self::ZERO;
+        None
+    }
+    fn remix(self, _m: &[[f32; 3]; 3]) -> Self {
+        self
+    }
     /// Wavelengths in nm.
     type Wavelengths = [f32; 4];
     const WAVELENGTH_DIMENSIONS: u32 = 1;

@@ -100,7 +100,13 @@ impl Scatter<HeroSample> for Bsdf {
                 (Some(Bsdf::Lambert(l)), Some(m)) => lambert(l, Some(m), wo, wi, lambda),
                 (Some(Bsdf::OrenNayar(o)), Some(m)) => oren_nayar(o, Some(m), wo, wi, lambda),
                 (Some(base), _) => base.eval_at(wo, wi, mode, lambda),
-                (None, _) => upsample(b.eval_mode(wo, wi, mode), lambda),
+                (None, _) => fluorescent_elastic(
+                    b,
+                    wo,
+                    wi,
+                    upsample(b.eval_mode(wo, wi, mode), lambda),
+                    lambda,
+                ),
             },
         }
     }
@@ -143,7 +149,7 @@ impl Scatter<HeroSample> for Bsdf {
                 Some(base) => base.sample_at(wo, uc, u, mode, lambda),
                 None => {
                     let s = b.sample_mode(wo, uc, u, mode)?;
-                    let f = upsample(s.f, lambda);
+                    let f = fluorescent_elastic(b, wo, s.wi, upsample(s.f, lambda), lambda);
                     // `weight = f |cos θi| / pdf` (BsdfSample::from_eval), except for the
                     // Reference walk's unbiased weight.
                     let weight = if s.pdf_is_proportional {
@@ -196,6 +202,35 @@ impl Scatter<HeroSample> for Bsdf {
             _ => Bxdf::<RgbSample>::pdf(self, wo, wi),
         }
     }
+}
+
+/// The elastic reflection of a coated fluorescent base (issue 20) with its measured reflectance
+/// per wavelength: the stack's upsampled RGB value `f` with its single-scatter base term
+/// `D(wo, wi) · ρ` ([`super::layered::fluorescent`]: the Corrected model's body for a Lambert base
+/// of albedo `ρ`) moved from the upsampled RGB albedo to `ρ(λ)`. The dye absorbs most of the
+/// laser's green: its elastic `ρ(532 nm)` is 0.09 where the upsampled projection gives several
+/// times more. The multiple-reflection lobe and the albedo calibration keep their RGB values.
+/// Any other stack: `f` unchanged.
+#[inline]
+fn fluorescent_elastic(
+    b: &super::LayeredBsdf,
+    wo: Vec3,
+    wi: Vec3,
+    f: HeroSample,
+    lambda: &HeroWavelengths,
+) -> HeroSample {
+    let (Some(m), Some(_), Bsdf::Lambert(base)) = (b.base_spectrum, b.fluorescence(), &b.base)
+    else {
+        return f;
+    };
+    let d = b.fluorescent_value(wo, wi);
+    if !(d > 0.0) {
+        return f;
+    }
+    let rgb = upsample(base.albedo, lambda);
+    HeroSample(std::array::from_fn(|i| {
+        (f.0[i] + d * (m.at(lambda.lambda[i]) - rgb.0[i])).max(0.0)
+    }))
 }
 
 /// The base a coat-less stack evaluates to (the course's plain base for the Course model, the

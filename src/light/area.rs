@@ -17,6 +17,7 @@ use crate::geometry::{Frame, Ray};
 use crate::sampler::concentric_disc;
 use crate::scene::stage::{AreaLight, LightShape};
 use crate::spectrum::Spectral;
+use crate::spectrum::line::Line;
 use crate::spectrum::measured::Measured;
 use glam::{DVec3, Vec2, Vec3};
 use std::f32::consts::PI;
@@ -50,6 +51,11 @@ pub struct Area {
     two_sided: bool,
     area: f32,
     spectrum: Option<&'static Measured>,
+    /// A narrow emission line (a laser's), exclusive with `spectrum`.
+    line: Option<Line>,
+    /// `cos` of the beam's half-angle: directions closer than it to `n` carry the radiance; −1
+    /// for a light that fills its hemisphere.
+    cos_beam: f32,
 }
 
 /// The spherical rectangle a rectangle subtends from a point `o` (Ureña et al. 2013, §3), in
@@ -74,6 +80,13 @@ struct SphericalRect {
 enum Strategy {
     Spherical(SphericalRect),
     Area,
+    /// A beam's footprint: the points of the light's plane within `radius` of `foot` (the
+    /// projection of the shading point) — exactly those whose direction to the point lies inside
+    /// the beam's cone — sampled uniformly by area.
+    Beam {
+        foot: Vec3,
+        radius: f32,
+    },
 }
 
 impl Area {
@@ -115,6 +128,10 @@ impl Area {
             two_sided: light.two_sided,
             area: if ok { area } else { 0.0 },
             spectrum: light.spectrum.map(Measured::intern),
+            line: light.line,
+            cos_beam: light
+                .divergence
+                .map_or(-1.0, |d| d.clamp(0.0, std::f32::consts::FRAC_PI_2).cos()),
         }
     }
 
@@ -129,9 +146,11 @@ impl Area {
     /// that does not emit), else the colour's illuminant spectrum.
     #[inline]
     pub fn emission<S: Spectral>(&self, rgb: Rgb, lambda: &S::Wavelengths) -> S {
-        match self.spectrum {
-            Some(m) if rgb != Rgb::ZERO => S::from_measured(m, rgb, lambda),
-            _ => S::from_illuminant(rgb, lambda),
+        match (self.spectrum, self.line) {
+            _ if rgb == Rgb::ZERO => S::ZERO,
+            (Some(m), _) => S::from_measured(m, rgb, lambda),
+            (None, Some(line)) => S::from_emission_fn(|l| line.eval(l), rgb, lambda),
+            (None, None) => S::from_illuminant(rgb, lambda),
         }
     }
 
@@ -149,14 +168,16 @@ impl Area {
     /// W·sr⁻¹·m⁻²); used to choose among lights.
     pub fn power(&self) -> f32 {
         let sides = if self.two_sided { 2.0 } else { 1.0 };
-        (PI * self.area * self.radiance.luminance() * sides).max(0.0)
+        // A beam of half-angle θ emits π sin²θ per unit radiance and area instead of π.
+        let cone = 1.0 - self.cos_beam.max(0.0).powi(2);
+        (PI * cone * self.area * self.radiance.luminance() * sides).max(0.0)
     }
 
     /// Emitted radiance toward direction `w` (unit, leaving the light): the light's radiance when
     /// `w` leaves an emitting face, else zero.
     pub fn emitted(&self, w: Vec3) -> Rgb {
         let c = w.dot(self.frame.n);
-        if self.area > 0.0 && (c > 0.0 || (self.two_sided && c < 0.0)) {
+        if self.area > 0.0 && (c > 0.0 || (self.two_sided && c < 0.0)) && c >= self.cos_beam {
             self.radiance
         } else {
             Rgb::ZERO
@@ -203,6 +224,17 @@ impl Area {
         let side = (p - self.center).dot(self.frame.n);
         if !(side > 0.0 || (self.two_sided && side < 0.0)) {
             return None;
+        }
+        if self.cos_beam > 0.0 {
+            // A beam (issue 20): only the light's points within the cone's footprint reach `p`;
+            // sampling the footprint instead of the whole light finds them every time. Where the
+            // footprint is larger than the light, area sampling wastes less.
+            let tan = (1.0 - self.cos_beam * self.cos_beam).max(0.0).sqrt() / self.cos_beam;
+            let radius = side * tan;
+            if PI * radius * radius < self.area && radius > 0.0 && radius.is_finite() {
+                let foot = p - self.frame.n * side;
+                return Some(Strategy::Beam { foot, radius });
+            }
         }
         let spherical = match self.outline {
             Outline::Rect { hx, hy } => self.spherical_rect(p, hx, hy),
@@ -263,6 +295,24 @@ impl Area {
                 self.record(wi, dist as f32, pdf)
             }
             Strategy::Area => self.sample_area(p, u),
+            Strategy::Beam { foot, radius } => {
+                let d = concentric_disc(u) * radius;
+                let q = foot + self.frame.s * d.x + self.frame.t * d.y;
+                let local = q - self.center;
+                let (a, b) = (local.dot(self.frame.s), local.dot(self.frame.t));
+                let inside = match self.outline {
+                    Outline::Rect { hx, hy } => a.abs() <= hx && b.abs() <= hy,
+                    Outline::Disc { radius } => a * a + b * b <= radius * radius,
+                };
+                if !inside {
+                    return None;
+                }
+                let d = q - p;
+                let dist = d.length();
+                let wi = d / dist;
+                let pdf = dist * dist / (PI * radius * radius * wi.dot(self.frame.n).abs());
+                self.record(wi, dist, pdf)
+            }
         }
     }
 
@@ -318,6 +368,12 @@ impl Area {
         let pdf = match strategy {
             Strategy::Spherical(sr) => (1.0 / sr.solid_angle) as f32,
             Strategy::Area => hit * hit / (self.area * wi.dot(self.frame.n).abs()),
+            Strategy::Beam { foot, radius } => {
+                if (p + wi * hit - foot).length() > radius * (1.0 + EDGE_SLACK) {
+                    return 0.0;
+                }
+                hit * hit / (PI * radius * radius * wi.dot(self.frame.n).abs())
+            }
         };
         positive_or_zero(pdf)
     }
@@ -370,6 +426,8 @@ mod tests {
             radiance,
             two_sided,
             spectrum: None,
+            line: None,
+            divergence: None,
         })
     }
 

@@ -482,6 +482,13 @@ impl Compiler<'_> {
                 format!("{element} base.albedo spectrum ({file})"),
             );
         }
+        // A fluorescent base moves light between wavelengths: exactly in spectral transport
+        // (which it calls for), by the reduced 3 × 3 matrix when `spectral=off`.
+        if stack.fluorescence.is_some() {
+            let element = format!("{element} base.fluorescence ({file})");
+            self.effects.turn_on(Effect::Fluorescence, element.clone());
+            self.effects.turn_on(Effect::Spectral, element);
+        }
     }
 }
 

@@ -4,7 +4,7 @@
 //! ```ron
 //! (
 //!     coats: [(ior: 1.6, roughness: 12.0, thickness: 0.5)],
-//!     base: Lambert(albedo: Srgb(0.37, 0.09, 0.11)),
+//!     base: Lambert(albedo: Srgb(0.37, 0.09, 0.11)), // optional: fluorescence: (…)
 //!     // optional: model: Corrected | Course | Reference(samples: 4, max_depth: 256),
 //!     //           fresnel: Exact | Schlick | Lazanyi | Table,
 //!     //           distribution: Blinn | Beckmann | Ggx, masking: VCavity | Smith | SmithSeparable,
@@ -80,8 +80,11 @@ pub enum MetalDesc {
 pub enum BaseDesc {
     /// Lambertian with albedo 0 ..= 1.
     Lambert {
-        /// Albedo.
+        /// Albedo (with `fluorescence`: the substrate's, before the colorant absorbs).
         albedo: ColorDesc,
+        /// A fluorescent colorant in the base (issue 20; [`super::fluorescence`]).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        fluorescence: Option<super::fluorescence::FluorescenceDesc>,
     },
     /// Oren–Nayar with albedo and slope deviation σ in radians (0 ..= 1.5).
     OrenNayar {
@@ -282,8 +285,22 @@ impl MaterialDesc {
             }
             None => albedo.to_rgb().map_err(|e| format!("base.albedo: {e}")),
         };
+        let mut fluorescence = None;
         let base = match &self.base {
-            BaseDesc::Lambert { albedo } => Base::Lambert {
+            BaseDesc::Lambert {
+                albedo,
+                fluorescence: Some(f),
+            } => {
+                let c = f.compile(albedo)?;
+                let rgb = c.elastic.to_rgb().map(|v| v.min(1.0));
+                base_spectrum = Some(c.elastic.intern());
+                fluorescence = Some(c.colorant);
+                Base::Lambert { albedo: rgb }
+            }
+            BaseDesc::Lambert {
+                albedo,
+                fluorescence: None,
+            } => Base::Lambert {
                 albedo: albedo_of(albedo)?,
             },
             BaseDesc::OrenNayar { albedo, sigma } => Base::OrenNayar {
@@ -326,6 +343,7 @@ impl MaterialDesc {
             compensation: self.compensation,
             calibration: self.calibration,
             base_spectrum,
+            fluorescence,
         })
     }
 }

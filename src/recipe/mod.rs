@@ -11,6 +11,7 @@ mod ranged;
 pub mod body;
 pub mod color;
 mod compile;
+pub mod fluorescence;
 pub mod gem;
 pub mod library;
 mod map_compiler;

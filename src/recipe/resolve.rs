@@ -139,20 +139,58 @@ pub(crate) fn stage(
                 ));
                 continue;
             }
-            let (radiance, spectrum) = match l {
+            let (radiance, spectrum, line, divergence, two_sided) = match l {
                 LightDesc::Rect {
                     radiance,
                     intensity,
                     spectrum,
+                    line,
+                    divergence,
+                    two_sided,
                     ..
                 }
                 | LightDesc::Disc {
                     radiance,
                     intensity,
                     spectrum,
+                    line,
+                    divergence,
+                    two_sided,
                     ..
-                } => (colour(radiance) * *intensity, spectrum),
+                } => (
+                    colour(radiance) * *intensity,
+                    spectrum,
+                    line,
+                    *divergence,
+                    *two_sided,
+                ),
             };
+            let light_error = |key: &str, m: &str| {
+                let at = lights_at.and_then(|l| src.nth_element(l, i)).or(lights_at);
+                let at = at.and_then(|a| src.find_from(a, &[key, ":"])).or(at);
+                src.error(at, format!("stage.lights[{i}].{key}: {m}"))
+            };
+            if line.is_some() && spectrum.is_some() {
+                errors.push(light_error(
+                    "line",
+                    "give either `spectrum` or `line`, not both",
+                ));
+                continue;
+            }
+            if divergence.is_some() && two_sided {
+                errors.push(light_error(
+                    "divergence",
+                    "a beam is one-sided: remove `two_sided` or `divergence`",
+                ));
+                continue;
+            }
+            let divergence = divergence.map(f32::to_radians);
+            let line = line.as_ref().map(|d| {
+                crate::spectrum::line::Line::new(d.wavelength, d.fwhm)
+                    .with_luminance(radiance.luminance())
+            });
+            // A line gives the light its colour and keeps its luminance.
+            let radiance = line.map_or(radiance, |l| l.to_rgb_emission());
             // A measured spectrum keeps the light's luminance and gives it its colour.
             let (radiance, spectrum) = match spectrum {
                 None => (radiance, None),
@@ -187,6 +225,8 @@ pub(crate) fn stage(
                 } => AreaLight {
                     two_sided: *two_sided,
                     spectrum,
+                    line,
+                    divergence,
                     ..rect_light(center, target, *size, radiance)
                 },
                 LightDesc::Disc {
@@ -198,6 +238,8 @@ pub(crate) fn stage(
                     radiance,
                     two_sided: *two_sided,
                     spectrum,
+                    line,
+                    divergence,
                 },
             });
         }
@@ -307,6 +349,9 @@ pub(crate) fn stage_effects(stage: &Stage, effects: &mut Effects) {
     for (i, l) in stage.lights.iter().enumerate() {
         if l.spectrum.is_some() {
             effects.turn_on(Effect::Spectral, format!("stage.lights[{i}].spectrum"));
+        }
+        if l.line.is_some() {
+            effects.turn_on(Effect::Spectral, format!("stage.lights[{i}].line"));
         }
     }
 }

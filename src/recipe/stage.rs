@@ -32,6 +32,27 @@ ranged!(intensity_range, "intensity", 0.0, 1e6);
 ranged!(exposure_range, "exposure", -30.0, 30.0);
 ranged!(filter_radius_range, "radius", 0.5, 4.0);
 ranged!(factor_range, "scale", open 0.0, 1e4);
+ranged!(line_wavelength_range, "wavelength", 360.0, 830.0);
+ranged!(line_fwhm_range, "fwhm", 0.1, 100.0);
+ranged!(divergence_value, "divergence", open 0.0, 45.0);
+
+/// `divergence`, degrees, `0 <.. 45`.
+fn divergence_range<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f32>, D::Error> {
+    divergence_value(d).map(Some)
+}
+
+/// A narrow emission line: a laser's or a monochromatic lamp's ([`crate::spectrum::line`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LineDesc {
+    /// Centre, nm, 360 ..= 830.
+    #[serde(deserialize_with = "line_wavelength_range")]
+    pub wavelength: f32,
+    /// Full width at half maximum, nm, 0.1 ..= 100 (default 1). Narrower lines are noisier in
+    /// spectral renders: a path's wavelengths land in the line less often.
+    #[serde(default = "one", deserialize_with = "line_fwhm_range")]
+    pub fwhm: f32,
+}
 
 type V3 = (f32, f32, f32);
 
@@ -350,6 +371,14 @@ pub enum LightDesc {
         /// `radiance × intensity` (its colour replaces `radiance`'s). Turns spectral transport on.
         #[serde(default)]
         spectrum: Option<super::spectrum::SpectrumDesc>,
+        /// A narrow emission line instead of `spectrum`, `(wavelength: 532, fwhm: 1)`: a
+        /// monochromatic lamp or, with `divergence`, a laser. Turns spectral transport on.
+        #[serde(default)]
+        line: Option<LineDesc>,
+        /// Emit only within this half-angle (degrees, 0 <.. 45) of the direction to `target`:
+        /// a beam (a laser's divergence). One-sided.
+        #[serde(default, deserialize_with = "divergence_range")]
+        divergence: Option<f32>,
     },
     /// A disc.
     Disc {
@@ -374,6 +403,13 @@ pub enum LightDesc {
         /// A measured relative spectral power distribution (as for `Rect`).
         #[serde(default)]
         spectrum: Option<super::spectrum::SpectrumDesc>,
+        /// A narrow emission line (as for `Rect`).
+        #[serde(default)]
+        line: Option<LineDesc>,
+        /// A beam's half-angle, degrees (as for `Rect`): a laser is a `Disc` of the beam's radius
+        /// with a `line` and a `divergence`.
+        #[serde(default, deserialize_with = "divergence_range")]
+        divergence: Option<f32>,
     },
 }
 

@@ -77,7 +77,7 @@ pub(super) fn direct_light<S: Spectral>(
     };
     let c = path.throughput() * f * radiance * (wi_local.z.abs() * w / p_light);
     if c.is_valid() {
-        path.l += c;
+        path.gather(c);
     }
 }
 

@@ -43,6 +43,19 @@
 //! the BSDF-sampled continuation follows the walk's chain, so a light it reaches is weighted
 //! against the walk (`direct::manifold_weight`).
 //!
+//! **Fluorescence** (issue 20). At a hit on a fluorescent base ([`crate::bsdf::layered::fluorescent`])
+//! the path picks, before next-event estimation, the fluorescent lobe with probability
+//! [`FLUORESCENT_SHARE`] or the elastic stack otherwise, and divides by the probability (a
+//! one-sample estimate of their sum). Taking the fluorescent lobe, the throughput takes the
+//! re-radiation ([`Spectral::fluoresce`]): in spectral transport each carried wavelength `λo`
+//! draws the excitation wavelength `λi ≤ λo` that fed it, weighted by `K/p`, and the path carries
+//! `λi` from there (`path.lambda`) while the film keeps `λo` (`path.film`) — the hero-wavelength
+//! fluorescence of Mojzík, Fichet & Wilkie, EGSR 2018, with one excitation sample per carried
+//! wavelength; in RGB the matrix moves throughput between channels. The vertex's next-event
+//! estimation and BSDF sample then use that lobe alone. Scenes without a fluorescent base never
+//! enter this code (`world.fluorescence`, the `fluorescence` effect), and `film == lambda` on
+//! every path that does not fluoresce, so their renders are unchanged bit for bit.
+//!
 //! **Variants.** [`trace`] is generic over the transported light `S` and monomorphised per variant
 //! ([`crate::spectrum`]); the film receives the path's radiance as a stored colour.
 //!
@@ -66,6 +79,9 @@ use glam::Vec3;
 /// Bounces after which Russian roulette may end a path.
 const RR_DEPTH: u32 = 3;
 
+/// The probability that a path at a fluorescent base takes the fluorescent lobe (module docs).
+const FLUORESCENT_SHARE: f32 = 0.5;
+
 /// Traces one camera path carrying transported light `S` (`trace::<RgbSample>` for the RGB
 /// variant).
 ///
@@ -86,7 +102,7 @@ where
     Bsdf: Scatter<S>,
 {
     let lambda = if S::WAVELENGTH_DIMENSIONS > 0 {
-        S::sample_wavelengths(sampler.get2d_at(slots::WAVELENGTH).x)
+        S::sample_wavelengths_with(sampler.get2d_at(slots::WAVELENGTH), &world.lines)
     } else {
         S::sample_wavelengths(0.0)
     };
@@ -198,7 +214,7 @@ where
                             let w = manifold_weight(strategy, ml.pdf, f * ml.cross, true);
                             let c = path.throughput() * ml.value * (f * w);
                             if c.is_valid() {
-                                path.l += c;
+                                path.gather(c);
                             }
                         }
                         path.manifold = Some(ManifoldVertex {
@@ -260,7 +276,7 @@ where
         };
         let wo = -ray.dir;
         let u_switch = sampler.get1d();
-        let Some(sb) = shade(
+        let Some(mut sb) = shade(
             world,
             &hit,
             wo,
@@ -273,6 +289,30 @@ where
         };
         if path.bounces() >= max_depth {
             break;
+        }
+        // A fluorescent base (module docs): the fluorescent lobe with probability
+        // FLUORESCENT_SHARE — the throughput takes the re-radiation and the path carries the
+        // excitation wavelengths from here — else the elastic stack.
+        if world.fluorescence
+            && let Some(colorant) = sb.fluorescence()
+        {
+            let u = sampler.get2d_at(slots::fluorescence(path.depth));
+            if u.x < FLUORESCENT_SHARE {
+                let u = glam::Vec2::new(u.x / FLUORESCENT_SHARE, u.y);
+                if let Some(m) = path
+                    .beta
+                    .fluoresce(&mut path.lambda, colorant, &world.lines, u)
+                {
+                    path.take_remap(&m);
+                }
+                path.beta *= 1.0 / FLUORESCENT_SHARE;
+                sb.fluoresce();
+            } else {
+                path.beta *= 1.0 / (1.0 - FLUORESCENT_SHARE);
+            }
+            if !path.alive() {
+                break;
+            }
         }
         let wo_local = sb.frame.to_local(wo);
         let u_light = sampler.get1d();
@@ -339,7 +379,7 @@ where
             let w = manifold_weight(strategy, ml.pdf, p_bsdf, true);
             let c = path.throughput() * f * ml.value * (wi_local.z.abs() * w);
             if c.is_valid() {
-                path.l += c;
+                path.gather(c);
             }
         }
         let walk = start.map(|(_, v, _)| v);
@@ -382,6 +422,7 @@ where
         if bs.terminate_secondary {
             // A dispersive refraction sent each wavelength its own way: only the hero goes on.
             S::terminate_secondary(&mut path.lambda);
+            S::terminate_secondary(&mut path.film);
         }
         path.scatter(&bs, sb.p, sb.inside);
         path.platelet = match hit {
@@ -419,12 +460,12 @@ where
         // linear map of it that may leave the gamut (crate::spectrum::hero).
         out.signed = true;
         out.radiance = if path.l.is_valid() {
-            path.l.to_rgb(&path.lambda)
+            path.l.to_rgb(&path.film)
         } else {
             Rgb::splat(f32::NAN)
         };
     } else {
-        out.radiance = path.l.to_rgb(&path.lambda);
+        out.radiance = path.l.to_rgb(&path.film);
     }
     (out, path.l)
 }

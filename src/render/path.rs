@@ -85,8 +85,19 @@ pub struct PathState<S: Spectral> {
     pub eta_scale: f32,
     /// The medium the current ray travels through.
     pub medium: MediumId,
-    /// The path's wavelengths (zero-sized in the RGB variant).
+    /// The wavelengths the path's light is carried at (zero-sized in the RGB variant); after a
+    /// fluorescent re-radiation, the excitation wavelengths that fed `film`.
     pub lambda: S::Wavelengths,
+    /// The wavelengths the camera sees, with the densities they were drawn with: what the
+    /// radiance `l` is projected onto the film at. The same as `lambda` until the path meets a
+    /// fluorescent base.
+    pub film: S::Wavelengths,
+    /// RGB transport after a fluorescent re-radiation (issue 20): the 3 × 3 map from the
+    /// channels the path carries to the film's (`diag(β) · M` at the event, composed over
+    /// events); contributions pass through it ([`PathState::gather`]) and `β` restarts at one.
+    /// `None` on every path that has not fluoresced and always in spectral transport, which
+    /// changes its wavelengths instead.
+    pub remap: Option<[[f32; 3]; 3]>,
     /// Scattering events so far (surface and medium; it positions the sampler's slots).
     pub depth: u32,
     /// Of those, scattering events in a medium (bounded by `medium-depth`, not `max-depth`).
@@ -110,6 +121,8 @@ impl<S: Spectral> PathState<S> {
             eta_scale: 1.0,
             medium,
             lambda,
+            film: lambda,
+            remap: None,
             depth: 0,
             medium_events: 0,
             prev: None,
@@ -158,7 +171,38 @@ impl<S: Spectral> PathState<S> {
     /// Adds emitted radiance `le` reaching the path with MIS weight `w`.
     #[inline]
     pub fn add_emission(&mut self, le: S, w: f32) {
-        self.l += self.throughput() * le * w;
+        self.gather(self.throughput() * le * w);
+    }
+
+    /// Adds a contribution `c` (throughput × radiance, in the channels the path carries) to the
+    /// radiance, through the fluorescent remap if the path has one.
+    #[inline]
+    pub fn gather(&mut self, c: S) {
+        match &self.remap {
+            None => self.l += c,
+            Some(m) => self.l += c.remix(m),
+        }
+    }
+
+    /// Takes an RGB re-radiation matrix `m` (rows: outgoing channels, columns: incident):
+    /// the film map becomes `remap · diag(β) · m`, and `β` one.
+    #[inline]
+    pub fn take_remap(&mut self, m: &[[f32; 3]; 3]) {
+        let b: [f32; 3] = std::array::from_fn(|c| {
+            if c < S::CHANNELS {
+                self.beta.channel(c)
+            } else {
+                0.0
+            }
+        });
+        let local: [[f32; 3]; 3] = std::array::from_fn(|r| std::array::from_fn(|k| b[r] * m[r][k]));
+        self.remap = Some(match &self.remap {
+            None => local,
+            Some(prev) => std::array::from_fn(|r| {
+                std::array::from_fn(|k| (0..3).map(|j| prev[r][j] * local[j][k]).sum())
+            }),
+        });
+        self.beta = S::ONE;
     }
 
     /// Takes a free flight's `value` and per-channel `pdf` ([`crate::medium::FreeFlight`]):

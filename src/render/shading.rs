@@ -5,9 +5,12 @@
 
 use super::path::PathSample;
 use super::world::{Hit, World};
-use crate::bsdf::{Bsdf, BsdfSample, Bxdf, LobeFlags, Scatter, TransportMode};
+use crate::bsdf::{
+    Bsdf, BsdfSample, Bxdf, LayeredBsdf, Lobe, LobeFlags, LobeKind, Scatter, TransportMode,
+};
 use crate::geometry::{Frame, MediumId};
 use crate::spectrum::Spectral;
+use crate::spectrum::fluorescence::Fluorescence;
 use crate::texture::bump::facet_frame;
 use glam::{Vec2, Vec3};
 
@@ -49,6 +52,9 @@ pub struct SurfaceBsdf<'a> {
     pub faceted: bool,
     bxdf: &'a Bsdf,
     flags: LobeFlags,
+    /// Set by [`SurfaceBsdf::fluoresce`]: the path took the fluorescent lobe of the base
+    /// ([`crate::bsdf::layered::fluorescent`]), which `eval`, `pdf` and `sample` then describe.
+    fluorescent: Option<&'a LayeredBsdf>,
 }
 
 impl<'a> SurfaceBsdf<'a> {
@@ -56,6 +62,28 @@ impl<'a> SurfaceBsdf<'a> {
     #[inline]
     pub fn flags(&self) -> LobeFlags {
         self.flags
+    }
+
+    /// The colorant of a fluorescent base under this surface, if any.
+    #[inline]
+    pub fn fluorescence(&self) -> Option<&'a Fluorescence> {
+        match self.bxdf {
+            Bsdf::Layered(l) => l.fluorescence(),
+            _ => None,
+        }
+    }
+
+    /// Makes `eval`, `pdf` and `sample` describe the fluorescent lobe `D(wo, wi)` (achromatic:
+    /// the path's throughput has taken the re-radiation, [`Spectral::fluoresce`]). Does nothing
+    /// on a surface without a fluorescent base.
+    #[inline]
+    pub fn fluoresce(&mut self) {
+        if let Bsdf::Layered(l) = self.bxdf
+            && l.fluorescence().is_some()
+        {
+            self.fluorescent = Some(l);
+            self.flags = l.fluorescent_flags();
+        }
     }
 
     /// Whether world direction `wi` may carry light to or from `wo` (facing `ng`): on the front of
@@ -74,6 +102,9 @@ impl<'a> SurfaceBsdf<'a> {
         Bsdf: Scatter<S>,
     {
         let wi_local = self.frame.to_local(wi);
+        if let Some(l) = self.fluorescent {
+            return (wi_local, S::splat(l.fluorescent_value(wo_local, wi_local)));
+        }
         (
             wi_local,
             self.bxdf
@@ -87,6 +118,9 @@ impl<'a> SurfaceBsdf<'a> {
     where
         Bsdf: Scatter<S>,
     {
+        if let Some(l) = self.fluorescent {
+            return l.fluorescent_pdf(wo_local, wi_local);
+        }
         <Bsdf as Scatter<S>>::pdf_at(self.bxdf, wo_local, wi_local, lambda)
     }
 
@@ -103,9 +137,19 @@ impl<'a> SurfaceBsdf<'a> {
     where
         Bsdf: Scatter<S>,
     {
-        let mut bs = self
-            .bxdf
-            .sample_at(wo_local, uc, u, TransportMode::Radiance, lambda)?;
+        let mut bs = match self.fluorescent {
+            Some(l) => {
+                let fs = l.fluorescent_sample(wo_local, u)?;
+                let lobe = Lobe {
+                    kind: LobeKind::Diffuse,
+                    layer: l.coats() as u8,
+                };
+                BsdfSample::from_eval(fs.wi, S::splat(fs.value), fs.pdf, lobe)?
+            }
+            None => self
+                .bxdf
+                .sample_at(wo_local, uc, u, TransportMode::Radiance, lambda)?,
+        };
         bs.wi = self.frame.to_world(bs.wi).normalize();
         self.admits(bs.wi).then_some(bs)
     }
@@ -233,6 +277,7 @@ impl World {
             faceted,
             bxdf,
             flags: bxdf.flags(),
+            fluorescent: None,
         })
     }
 }

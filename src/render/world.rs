@@ -116,6 +116,14 @@ pub struct World {
     /// Whether paths carry wavelengths (the `spectral` effect): [`super::render`] then traces
     /// [`crate::spectrum::HeroSample`] instead of RGB.
     pub spectral: bool,
+    /// Whether fluorescent bases re-radiate (the `fluorescence` effect): at a hit on one a path
+    /// picks the fluorescent or the elastic lobe ([`super::integrator`]). Off: only the elastic
+    /// reflectance (the colorant still absorbs).
+    pub fluorescence: bool,
+    /// The lights' narrow emission lines (issue 20): spectral paths draw their wavelengths, and
+    /// fluorescent excitations, partly from them ([`crate::spectrum::line`]). Empty in most
+    /// scenes, which then sample exactly as before.
+    pub lines: Vec<crate::spectrum::line::Line>,
     /// Centre and radius of a sphere bounding the stone, the floor patch under it and the lights.
     pub bounds: (Vec3, f32),
 }
@@ -397,6 +405,8 @@ impl World {
             }),
             facet_bump: scene.effects.on(Effect::FacetBump),
             spectral: scene.effects.on(Effect::Spectral),
+            fluorescence: scene.effects.on(Effect::Fluorescence),
+            lines: stage.lights.iter().filter_map(|l| l.line).collect(),
             bounds: (centre, radius),
         })
     }

@@ -24,6 +24,8 @@
 //! | [`slots::bounce`]`(b)` + 0 … 5 = `2 + 6b` … | bounce `b`: map switch, light choice, light point (2-D), lobe choice, direction (2-D), Russian roulette |
 //! | [`slots::WAVELENGTH`] = 2³¹ | the path's wavelengths (drawn only by a spectral variant) |
 //! | [`slots::medium`]`(b)` = 2³¹ + 1 + `b` | the distance sample of the ray segment before bounce `b` in a medium (2-D: distance, channel) |
+//! | [`slots::platelet`]`(b)` = 2³¹ + 1 + 2²⁰ + `b` | the statistical platelets' collision before bounce `b` (2-D) |
+//! | [`slots::fluorescence`]`(b)` = 2³¹ + 1 + 2²¹ + `b` | bounce `b` on a fluorescent base: lobe choice, excitation wavelengths (2-D) |
 //!
 //! The wavelength and medium slots live far above the bounce blocks: adding them left every
 //! number an RGB render of an opaque scene draws exactly where it was (the golden references kept
@@ -74,6 +76,19 @@ pub mod slots {
             MEDIUM_BOUNCES - 1
         };
         WAVELENGTH + 1 + MEDIUM_BOUNCES + b
+    }
+
+    /// The fluorescence slot of bounce `b` (issue 20): the choice between a fluorescent base's
+    /// fluorescent and elastic lobes, and the excitation wavelengths, read without moving the
+    /// counter.
+    #[inline]
+    pub const fn fluorescence(b: u32) -> u32 {
+        let b = if b < MEDIUM_BOUNCES {
+            b
+        } else {
+            MEDIUM_BOUNCES - 1
+        };
+        WAVELENGTH + 1 + 2 * MEDIUM_BOUNCES + b
     }
 }
 

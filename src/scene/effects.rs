@@ -83,7 +83,7 @@ impl Effect {
     /// Whether this version can simulate the effect at all (the others are slots for later work:
     /// no recipe element turns them on yet).
     pub fn implemented(self) -> bool {
-        !matches!(self, Effect::Fluorescence)
+        true
     }
 
     /// What turns the effect on.
@@ -111,7 +111,7 @@ impl Effect {
                 "a dispersive `body` IOR (Cauchy, Sellmeier or Abbe number), a measured medium or \
                  light spectrum, or `--spectral`"
             }
-            Effect::Fluorescence => "a fluorescent material",
+            Effect::Fluorescence => "a used material whose Lambert base has `fluorescence`",
             Effect::DepthOfField => "a perspective camera with aperture > 0",
             Effect::EnvironmentImportance => "an environment Map (EXR)",
         }

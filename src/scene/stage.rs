@@ -91,6 +91,12 @@ pub struct AreaLight {
     /// A measured emission spectrum (`radiance` is then its RGB colour): spectral paths read it
     /// at their wavelengths.
     pub spectrum: Option<crate::spectrum::measured::Measured>,
+    /// A narrow emission line instead (a laser's, a monochromatic lamp's), scaled to the
+    /// luminance of `radiance` (which is then its colour); exclusive with `spectrum`.
+    pub line: Option<crate::spectrum::line::Line>,
+    /// Half-angle of the cone about `normal` the light emits into, radians (a beam: a laser's
+    /// divergence); `None` for the whole hemisphere. One-sided.
+    pub divergence: Option<f32>,
 }
 
 /// The camera projection.
@@ -234,6 +240,8 @@ pub fn rect_light(center: Vec3, target: Vec3, size: (f32, f32), radiance: Rgb) -
         radiance,
         two_sided: false,
         spectrum: None,
+        line: None,
+        divergence: None,
     }
 }
 
@@ -298,6 +306,8 @@ impl Stage {
                     radiance: Rgb::splat(2500.0),
                     two_sided: false,
                     spectrum: None,
+                    line: None,
+                    divergence: None,
                 },
             ],
             camera,

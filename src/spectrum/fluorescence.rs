@@ -35,8 +35,10 @@
 //! CGF 43(4), 2024, with the primaries' spectra as the reduction's basis.
 
 use super::cie::{self, CMF_SAMPLES, LAMBDA_MAX, LAMBDA_MIN};
+use super::line::Line;
 use super::measured::Measured;
 use super::rgb2spec;
+use super::wavelengths::LINE_SHARE;
 
 /// 1 nm cells over 360–830 nm.
 const CELLS: usize = CMF_SAMPLES - 1;
@@ -52,6 +54,8 @@ pub struct Fluorescence {
     emission: Vec<f32>,
     /// `Q`.
     quantum_yield: f32,
+    /// [`Fluorescence::rgb_matrix`], computed once.
+    matrix: [[f32; 3]; 3],
 }
 
 /// A sampled excitation wavelength.
@@ -98,12 +102,15 @@ impl Fluorescence {
             acc += f64::from(v);
             cdf.push(acc);
         }
-        Ok(Fluorescence {
+        let mut f = Fluorescence {
             excitation: a,
             excitation_cdf: cdf,
             emission: e.iter().map(|v| (v / total) as f32).collect(),
             quantum_yield,
-        })
+            matrix: [[0.0; 3]; 3],
+        };
+        f.matrix = f.compute_rgb_matrix();
+        Ok(f)
     }
 
     /// The cell of `lambda` (clamped to the range).
@@ -182,6 +189,59 @@ impl Fluorescence {
         })
     }
 
+    /// [`Fluorescence::sample_excitation`] mixed with the scene's narrow emission lines (a
+    /// laser's): with probability [`LINE_SHARE`] (when some line's support starts below `λo`;
+    /// `u_select` decides) `λi` is drawn uniformly from one such line's support clipped at `λo`,
+    /// else from `a`; the density is the mixture's, `(1 − c) a(λi)/A(λo) + (c/m) Σ_j
+    /// [λi ∈ S_j]/|S_j|`, and the weight `K/p` (module docs). A narrow line far inside a broad
+    /// excitation band is otherwise found by one path in hundreds. Without usable lines this is
+    /// [`Fluorescence::sample_excitation`] exactly.
+    pub fn sample_excitation_mixed(
+        &self,
+        lambda_o: f32,
+        lines: &[Line],
+        u_select: f32,
+        u: f32,
+    ) -> Option<ExcitationSample> {
+        let lambda_o = lambda_o.clamp(LAMBDA_MIN, LAMBDA_MAX);
+        let clipped = |l: &Line| {
+            let (lo, hi) = l.support();
+            let hi = hi.min(lambda_o);
+            (hi > lo).then_some((lo, hi))
+        };
+        let m = lines.iter().filter_map(clipped).count();
+        if m == 0 {
+            return self.sample_excitation(lambda_o, u);
+        }
+        let total = self.excitation_below(lambda_o);
+        let c = if total > 0.0 { LINE_SHARE } else { 1.0 };
+        let lambda = if u_select < c {
+            let j = ((u_select / c * m as f32) as usize).min(m - 1);
+            let (lo, hi) = lines.iter().filter_map(clipped).nth(j)?;
+            (lo + u.clamp(0.0, 1.0) * (hi - lo)).min(hi)
+        } else {
+            self.sample_excitation(lambda_o, u)?.lambda
+        };
+        let mut boxes = 0.0f32;
+        for (lo, hi) in lines.iter().filter_map(clipped) {
+            if lambda >= lo && lambda <= hi {
+                boxes += 1.0 / (hi - lo);
+            }
+        }
+        let p_a = if total > 0.0 {
+            (f64::from(self.excitation(lambda)) / total) as f32
+        } else {
+            0.0
+        };
+        let pdf = (1.0 - c) * p_a + c * boxes / m as f32;
+        let k = self.kernel(lambda, lambda_o);
+        (pdf > 0.0 && k > 0.0).then(|| ExcitationSample {
+            lambda,
+            pdf,
+            weight: k / pdf,
+        })
+    }
+
     /// The energy re-emitted per unit energy absorbed-and-arriving at `λi`: `∫ K(λi → λo) dλo`
     /// (1 nm sums), at most `Q a(λi)`.
     pub fn reemitted_energy(&self, lambda_i: f32) -> f32 {
@@ -199,7 +259,13 @@ impl Fluorescence {
 
     /// The linear sRGB colour re-emitted under each unit primary's illuminant spectrum: column `k`
     /// for primary `k` (module docs). Multiply an incident RGB radiance by it for the RGB render.
-    pub fn rgb_matrix(&self) -> [[f32; 3]; 3] {
+    #[inline]
+    pub fn rgb_matrix(&self) -> &[[f32; 3]; 3] {
+        &self.matrix
+    }
+
+    /// [`Fluorescence::rgb_matrix`] from the spectra (3 × 470² kernel evaluations).
+    fn compute_rgb_matrix(&self) -> [[f32; 3]; 3] {
         let mut m = [[0.0f32; 3]; 3];
         for k in 0..3 {
             let mut primary = [0.0f32; 3];
@@ -220,8 +286,11 @@ impl Fluorescence {
                     .sum()
             };
             let rgb = cie::xyz_to_linear_srgb(cie::spectrum_to_xyz(out));
+            // An RGB render carries non-negative channels: a re-emission outside the sRGB gamut
+            // (an orange dye's emission has a slightly negative blue) is clamped, as measured
+            // emission is ([`super::measured::Measured::to_rgb_emission`]).
             for (c, v) in rgb.to_array().into_iter().enumerate() {
-                m[c][k] = v;
+                m[c][k] = v.max(0.0);
             }
         }
         m
@@ -371,7 +440,7 @@ mod tests {
     #[test]
     fn the_rgb_matrix_moves_green_to_red() {
         let f = dye();
-        let m = f.rgb_matrix();
+        let m = *f.rgb_matrix();
         // Red in, little out: the dye barely absorbs beyond 600 nm.
         assert!(m[0][0] < 0.05, "{m:?}");
         // Green in: mostly red out (orange emission), more than any other column sends to red.

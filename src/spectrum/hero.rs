@@ -218,6 +218,16 @@ impl Spectral for HeroSample {
         HeroSample::at(lambda, |l| m.at(l))
     }
 
+    #[inline]
+    fn sample_wavelengths_with(u: glam::Vec2, lines: &[super::line::Line]) -> HeroWavelengths {
+        HeroWavelengths::sample_with_lines(u.x, u.y, lines)
+    }
+
+    #[inline]
+    fn from_emission_fn(f: impl Fn(f32) -> f32, _rgb: Rgb, lambda: &HeroWavelengths) -> Self {
+        HeroSample::at(lambda, f)
+    }
+
     fn to_rgb(self, lambda: &HeroWavelengths) -> Rgb {
         let mut xyz = [0.0f64; 3];
         for i in 0..N {
@@ -273,6 +283,34 @@ impl Spectral for HeroSample {
     #[inline]
     fn terminate_secondary(lambda: &mut HeroWavelengths) {
         lambda.terminate_secondary();
+    }
+
+    fn fluoresce(
+        &mut self,
+        lambda: &mut HeroWavelengths,
+        colorant: &super::fluorescence::Fluorescence,
+        lines: &[super::line::Line],
+        u: glam::Vec2,
+    ) -> Option<[[f32; 3]; 3]> {
+        for i in 0..N {
+            let mut ui = u.y + i as f32 / N as f32;
+            if ui >= 1.0 {
+                ui -= 1.0;
+            }
+            match colorant.sample_excitation_mixed(lambda.lambda[i], lines, u.x, ui) {
+                Some(s) if self.0[i] != 0.0 => {
+                    self.0[i] *= s.weight;
+                    lambda.set(i, s.lambda);
+                }
+                _ => self.0[i] = 0.0,
+            }
+        }
+        None
+    }
+
+    #[inline]
+    fn remix(self, _m: &[[f32; 3]; 3]) -> Self {
+        self
     }
 }
 

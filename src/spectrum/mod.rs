@@ -27,6 +27,7 @@ pub mod basis;
 pub mod cie;
 pub mod fluorescence;
 pub mod hero;
+pub mod line;
 pub mod measured;
 pub mod rgb;
 pub mod rgb2spec;
@@ -100,6 +101,14 @@ pub trait Spectral:
         let _ = m;
         Self::from_unbounded(rgb, lambda)
     }
+    /// An emitted radiance given as a function of wavelength (nm), `rgb` its colour: the
+    /// spectral variant evaluates `f` at its wavelengths, the RGB variant (this default) uses
+    /// `rgb`.
+    #[inline]
+    fn from_emission_fn(f: impl Fn(f32) -> f32, rgb: Rgb, lambda: &Self::Wavelengths) -> Self {
+        let _ = f;
+        Self::from_unbounded(rgb, lambda)
+    }
     /// The film colour of a path's radiance estimate carried at `lambda` (for a spectral variant
     /// this divides by the wavelengths' density and projects onto the colour matching functions).
     fn to_rgb(self, lambda: &Self::Wavelengths) -> Rgb;
@@ -120,6 +129,37 @@ pub trait Spectral:
     /// RGB variant has no wavelengths and ignores it.
     #[inline]
     fn terminate_secondary(_lambda: &mut Self::Wavelengths) {}
+    /// Re-radiation at a fluorescent base (issue 20; [`fluorescence`]): `self` is a path's
+    /// throughput toward the camera at `lambda`; afterwards it is the throughput of the light that
+    /// fed it, and `lambda` the wavelengths that light is carried at. The spectral variant draws,
+    /// per channel, an excitation wavelength `λi ≤ λo` with `u` (stratified over the channels)
+    /// and multiplies by `K(λi → λo) / p(λi)`; a channel nothing excites carries 0. The RGB
+    /// variant has no wavelengths: it returns the colorant's reduced 3 × 3 re-radiation matrix
+    /// `M` (rows outgoing, columns incident channels), which the path applies to everything it
+    /// gathers from there ([`Spectral::remix`]); the spectral variant returns `None`.
+    ///
+    /// # Arguments
+    /// * `lines` – the scene's narrow emission lines, which the excitation sampling also draws
+    ///   from ([`fluorescence::Fluorescence::sample_excitation_mixed`]).
+    /// * `u` – `(component choice, wavelength)`, each in `[0, 1)`.
+    fn fluoresce(
+        &mut self,
+        lambda: &mut Self::Wavelengths,
+        colorant: &fluorescence::Fluorescence,
+        lines: &[line::Line],
+        u: glam::Vec2,
+    ) -> Option<[[f32; 3]; 3]>;
+    /// `m · self` for an RGB value (channel mixing after a re-radiation); the spectral variant,
+    /// which never gets a matrix, returns `self`.
+    fn remix(self, m: &[[f32; 3]; 3]) -> Self;
+    /// The wavelengths of a camera path from the sampler's 2-D wavelength slot when the scene has
+    /// narrow emission `lines` ([`wavelengths::HeroWavelengths::sample_with_lines`]); without
+    /// lines, and in the RGB variant, [`Spectral::sample_wavelengths`]`(u.x)`.
+    #[inline]
+    fn sample_wavelengths_with(u: glam::Vec2, lines: &[line::Line]) -> Self::Wavelengths {
+        let _ = lines;
+        Self::sample_wavelengths(u.x)
+    }
 }
 
 #[cfg(test)]

@@ -85,6 +85,23 @@ impl RgbSample {
 }
 
 impl Spectral for RgbSample {
+    #[inline]
+    fn fluoresce(
+        &mut self,
+        _lambda: &mut super::RgbWavelengths,
+        colorant: &super::fluorescence::Fluorescence,
+        _lines: &[super::line::Line],
+        _u: glam::Vec2,
+    ) -> Option<[[f32; 3]; 3]> {
+        Some(*colorant.rgb_matrix())
+    }
+    #[inline]
+    fn remix(self, m: &[[f32; 3]; 3]) -> Self {
+        let v = self.0;
+        RgbSample(std::array::from_fn(|r| {
+            m[r][0] * v[0] + m[r][1] * v[1] + m[r][2] * v[2]
+        }))
+    }
     type Wavelengths = super::RgbWavelengths;
     const WAVELENGTH_DIMENSIONS: u32 = 0;
     const ZERO: Self = RgbSample::ZERO;

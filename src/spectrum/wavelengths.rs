@@ -99,6 +99,22 @@ pub fn sample_visible(u: f32) -> f32 {
     lambda.clamp(LAMBDA_MIN, LAMBDA_MAX)
 }
 
+/// The share of camera paths whose wavelengths are drawn from the scene's emission lines when it
+/// has any ([`HeroWavelengths::sample_with_lines`]).
+pub const LINE_SHARE: f32 = 0.5;
+
+/// The density per nm of [`HeroWavelengths::sample_with_lines`] at `lambda`.
+pub fn line_mixture_pdf(lambda: f32, lines: &[super::line::Line]) -> f32 {
+    let mut boxes = 0.0;
+    for l in lines {
+        let (lo, hi) = l.support();
+        if lambda >= lo && lambda <= hi && hi > lo {
+            boxes += 1.0 / (hi - lo);
+        }
+    }
+    (1.0 - LINE_SHARE) * visible_pdf(lambda) + LINE_SHARE * boxes / lines.len().max(1) as f32
+}
+
 /// The four wavelengths of a path and their densities.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct HeroWavelengths {
@@ -147,6 +163,46 @@ impl HeroWavelengths {
             w.illuminant[i] = c.illuminant[j] + f * (c.illuminant[j + 1] - c.illuminant[j]);
         }
         w
+    }
+
+    /// The four wavelengths of `u` when the scene has narrow emission lines (issue 20): with
+    /// probability [`LINE_SHARE`] (`u.y` decides) all four are drawn from one line's support
+    /// ([`super::line::Line::support`], uniformly, stratified as in [`HeroWavelengths::sample`]),
+    /// else from the visible density; each wavelength's density is the mixture's,
+    /// `(1 − c) p_vis(λ) + (c/n) Σ_j [λ ∈ support_j] / width_j`, so every channel is an unbiased
+    /// one-sample mixture estimate. Without lines this is [`HeroWavelengths::sample`] exactly.
+    pub fn sample_with_lines(u: f32, u_select: f32, lines: &[super::line::Line]) -> Self {
+        let mut w = HeroWavelengths::sample(u);
+        if lines.is_empty() {
+            return w;
+        }
+        let n = lines.len();
+        let pick = (u_select < LINE_SHARE)
+            .then(|| ((u_select / LINE_SHARE * n as f32) as usize).min(n - 1));
+        for i in 0..N {
+            if let Some(j) = pick {
+                let mut ui = u + i as f32 / N as f32;
+                if ui >= 1.0 {
+                    ui -= 1.0;
+                }
+                let (lo, hi) = lines[j].support();
+                w.set(i, lo + ui * (hi - lo));
+            }
+            w.pdf[i] = line_mixture_pdf(w.lambda[i], lines);
+        }
+        w
+    }
+
+    /// Carries wavelength `i` at `lambda` nm from here on (a fluorescent re-radiation's excitation
+    /// wavelength): its D65 value follows; its density (the film's) is left as drawn.
+    pub fn set(&mut self, i: usize, lambda: f32) {
+        let c = constants();
+        let l = lambda.clamp(LAMBDA_MIN, LAMBDA_MAX);
+        self.lambda[i] = l;
+        let x = l - LAMBDA_MIN;
+        let j = (x as usize).min(c.illuminant.len() - 2);
+        let f = x - j as f32;
+        self.illuminant[i] = c.illuminant[j] + f * (c.illuminant[j + 1] - c.illuminant[j]);
     }
 
     /// Keeps only the hero wavelength (module docs); does nothing if already done.

@@ -151,4 +151,12 @@ fn effects_this_version_does_not_simulate_cannot_be_forced_on() {
         let (n, first) = differences(&auto, &film(&off));
         assert_eq!(n, 0, "{effect} forced off: {}", first.unwrap_or_default());
     }
+    // Every effect is simulated since issue 20 (fluorescence was the last slot): its code, forced
+    // on and off in this busy scene without a fluorescent base, changes nothing.
+    assert!(Effect::ALL.iter().all(|e| e.implemented()));
+    assert_untouched(
+        Effect::Fluorescence,
+        "a scene calling for eight other effects",
+        &busy,
+    );
 }

@@ -21,6 +21,7 @@ pub mod adding;
 pub mod calibrate;
 pub mod corrected;
 pub mod course;
+pub mod fluorescent;
 pub mod interface;
 pub mod reference;
 
@@ -165,6 +166,10 @@ pub struct StackDesc {
     /// projection). Spectral renders read it per wavelength when the stack has no coats; a coated
     /// stack's spectral value is its RGB value as a spectrum ([`crate::bsdf::spectral`]).
     pub base_spectrum: Option<&'static crate::spectrum::measured::Measured>,
+    /// A fluorescent colorant in a Lambert base (issue 20, [`fluorescent`]): the base's albedo
+    /// (and `base_spectrum`) are then its elastic reflectance; the colorant adds the fluorescent
+    /// lobe. Coats above it must not absorb.
+    pub fluorescence: Option<std::sync::Arc<crate::spectrum::fluorescence::Fluorescence>>,
 }
 
 impl StackDesc {
@@ -182,6 +187,7 @@ impl StackDesc {
             compensation: true,
             calibration: true,
             base_spectrum: None,
+            fluorescence: None,
         }
     }
     /// The same stack under another model.
@@ -309,6 +315,8 @@ pub struct LayeredBsdf {
     pub(crate) masking: Masking,
     /// A diffuse base's measured albedo spectrum ([`StackDesc::base_spectrum`]).
     pub(crate) base_spectrum: Option<&'static crate::spectrum::measured::Measured>,
+    /// The base's fluorescent colorant ([`fluorescent`]).
+    pub(crate) fluorescence: Option<std::sync::Arc<crate::spectrum::fluorescence::Fluorescence>>,
 }
 
 /// Roughness (degrees) of the placeholder micro-facet lobes a smooth coat carries.
@@ -409,6 +417,10 @@ impl LayeredBsdf {
             base_spectrum: match desc.base {
                 Base::Lambert { .. } | Base::OrenNayar { .. } => desc.base_spectrum,
                 Base::Conductor { .. } => None,
+            },
+            fluorescence: match desc.base {
+                Base::Lambert { .. } => desc.fluorescence.clone(),
+                _ => None,
             },
         };
         for l in (0..stack.levels.len()).rev() {
@@ -595,6 +607,27 @@ pub fn validate(desc: &StackDesc) -> Result<(), StackError> {
         && (p.samples == 0 || p.max_depth == 0)
     {
         return bad("model.Reference.samples/max_depth".into(), 0.0, ">= 1");
+    }
+    if desc.fluorescence.is_some() {
+        if !matches!(desc.base, Base::Lambert { .. }) {
+            return bad(
+                "base.fluorescence".into(),
+                1.0,
+                "only on a Lambert base (the course's fluorescent Lambertian base)",
+            );
+        }
+        if let Some(i) = desc
+            .coats
+            .iter()
+            .position(|c| c.thickness > 0.0 && c.absorption.max_channel() > 0.0)
+        {
+            return bad(
+                format!("coats[{i}].absorption over a fluorescent base"),
+                desc.coats[i].absorption.max_channel(),
+                "0 (a varnish over a fluorescent base must be clear: the lobe's coats are \
+                 achromatic)",
+            );
+        }
     }
     Ok(())
 }
