@@ -134,7 +134,7 @@ fn bad_settings_are_refused_before_rendering() {
             "course, corrected, reference",
         ),
         (vec!["--setting", "bump"], "key=value"),
-        (vec!["--setting", "fluorescence=on"], "does not simulate"),
+        (vec!["--setting", "fluorescence=maybe"], "on, off"),
         (vec!["--spp", "12"], "power of two"),
         (vec!["--budget", "0"], "0.05..=86400"),
     ] {

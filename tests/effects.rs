@@ -25,14 +25,12 @@
 //! environment importance, transmission and medium on the translucent pink Sunstone), and forcing
 //! the `t` term on in a coated Corrected scene changes it too — `t-term` is a model knob, not an
 //! on-demand effect, so its "scene that does not call for it" has no coats (or Reference-model
-//! coats). The two effects this version does not simulate (spectral, fluorescence) refuse to be
-//! forced on, naming "does not simulate" and leaving the scene unchanged, and forcing them off is a
-//! no-op. The medium's knobs (`medium-depth`, `medium-scattering`) change a scattering body and
+//! coats). Fluorescence (issue 20) forced on or off leaves every scene without a fluorescent base
+//! bit-identical, RGB and spectral. The medium's knobs (`medium-depth`, `medium-scattering`) change a scattering body and
 //! leave an opaque gem bit-identical.
 //!
 //! Scenes are 48 × 36 pixels at 16 spp (Sobol') on the studio stage unless a test says otherwise.
-//! The camera's and the sky's effects and the ones this version does not simulate are in
-//! [`stage`]; the translucent bodies' effects (issues 17 and 18) in [`translucent`].
+//! The camera's and the sky's effects and fluorescence are in [`stage`]; the translucent bodies' effects (issues 17 and 18) in [`translucent`].
 
 use lapidary::recipe::GemRecipe;
 use lapidary::render::{Control, Film, PixelSums, World, render};
@@ -189,7 +187,7 @@ fn untouched(effect: Effect, what: &str, scene: &Scene) -> Option<String> {
     // `spectral` forced on is not inert code but the other transport variant (its image differs
     // by what spectral rendering changes: tests/spectral_render.rs); forced off it is the RGB
     // renderer the scene gets anyway.
-    let states: &[bool] = if effect.implemented() && effect != Effect::Spectral {
+    let states: &[bool] = if effect != Effect::Spectral {
         &[false, true]
     } else {
         &[false]

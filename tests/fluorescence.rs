@@ -10,6 +10,10 @@
 //! share their random numbers, so adding the variances overstates the difference's error), give
 //! the green-to-orange ratio at each incidence, in spectral transport and with the RGB matrix.
 
+mod common;
+#[path = "fluorescence/sampling.rs"]
+mod sampling;
+
 use lapidary::bsdf::Bsdf;
 use lapidary::recipe::GemRecipe;
 use lapidary::render::{Control, World, render};
@@ -101,9 +105,8 @@ fn floor_parts(s: &Scene) -> (f64, f64) {
     assert_eq!(r.stats.dropped, 0);
     let mut sum = [0.0f64; 3];
     for p in r.film.pixels.iter().filter(|p| p.material == -1) {
-        let m = p.mean();
-        for c in 0..3 {
-            sum[c] += f64::from(m.0[c]);
+        for (s, v) in sum.iter_mut().zip(p.mean().0) {
+            *s += f64::from(v);
         }
     }
     let dot = |x: &[f64; 3], y: &[f64; 3]| x[0] * y[0] + x[1] * y[1] + x[2] * y[2];

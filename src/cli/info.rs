@@ -384,8 +384,7 @@ pub fn describe(recipe: &GemRecipe, scene: &Scene, points: u32) -> String {
                 )
             ),
             (_, _, Some(c)) => c,
-            _ if e.implemented() => format!("needs {}", e.trigger()),
-            _ => format!("slot for later work (will need {})", e.trigger()),
+            _ => format!("needs {}", e.trigger()),
         };
         let _ = writeln!(o, "  {state}  {:<24} {line}", e.name());
     }

@@ -53,9 +53,35 @@ pub struct Area {
     spectrum: Option<&'static Measured>,
     /// A narrow emission line (a laser's), exclusive with `spectrum`.
     line: Option<Line>,
-    /// `cos` of the beam's half-angle: directions closer than it to `n` carry the radiance; −1
-    /// for a light that fills its hemisphere.
-    cos_beam: f32,
+    /// A beam's cone (`divergence`), `None` for a light that fills its hemisphere.
+    beam: Option<Beam>,
+}
+
+/// The cone of a beam of half-angle `θ`, kept as `sin² θ` and `tan θ` (computed in `f64` from the
+/// angle): near the axis `cos θ` rounds to within an ulp of 1, while `|w × n|² ≤ sin² θ` resolves a
+/// 0.3° cone to 1e-7 of its width.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Beam {
+    sin2: f32,
+    tan: f32,
+}
+
+impl Beam {
+    fn new(half_angle: f32) -> Beam {
+        let t = f64::from(half_angle.clamp(0.0, 1.5));
+        Beam {
+            sin2: t.sin().powi(2) as f32,
+            tan: t.tan() as f32,
+        }
+    }
+
+    /// Whether the unit direction `w` (leaving the light) lies in the cone about `n`, with a
+    /// relative slack of 1e-5 on `sin² θ`, so that the footprint's rim, sampled by
+    /// [`Strategy::Beam`], is inside after rounding.
+    #[inline]
+    fn admits(&self, w: Vec3, n: Vec3) -> bool {
+        w.dot(n) > 0.0 && w.cross(n).length_squared() <= self.sin2 * (1.0 + 1e-5)
+    }
 }
 
 /// The spherical rectangle a rectangle subtends from a point `o` (Ureña et al. 2013, §3), in
@@ -129,9 +155,7 @@ impl Area {
             area: if ok { area } else { 0.0 },
             spectrum: light.spectrum.map(Measured::intern),
             line: light.line,
-            cos_beam: light
-                .divergence
-                .map_or(-1.0, |d| d.clamp(0.0, std::f32::consts::FRAC_PI_2).cos()),
+            beam: light.divergence.map(Beam::new),
         }
     }
 
@@ -169,7 +193,7 @@ impl Area {
     pub fn power(&self) -> f32 {
         let sides = if self.two_sided { 2.0 } else { 1.0 };
         // A beam of half-angle θ emits π sin²θ per unit radiance and area instead of π.
-        let cone = 1.0 - self.cos_beam.max(0.0).powi(2);
+        let cone = self.beam.map_or(1.0, |b| b.sin2);
         (PI * cone * self.area * self.radiance.luminance() * sides).max(0.0)
     }
 
@@ -177,7 +201,10 @@ impl Area {
     /// `w` leaves an emitting face, else zero.
     pub fn emitted(&self, w: Vec3) -> Rgb {
         let c = w.dot(self.frame.n);
-        if self.area > 0.0 && (c > 0.0 || (self.two_sided && c < 0.0)) && c >= self.cos_beam {
+        if self.area > 0.0
+            && (c > 0.0 || (self.two_sided && c < 0.0))
+            && self.beam.is_none_or(|b| b.admits(w, self.frame.n))
+        {
             self.radiance
         } else {
             Rgb::ZERO
@@ -225,12 +252,11 @@ impl Area {
         if !(side > 0.0 || (self.two_sided && side < 0.0)) {
             return None;
         }
-        if self.cos_beam > 0.0 {
+        if let Some(beam) = self.beam {
             // A beam (issue 20): only the light's points within the cone's footprint reach `p`;
             // sampling the footprint instead of the whole light finds them every time. Where the
             // footprint is larger than the light, area sampling wastes less.
-            let tan = (1.0 - self.cos_beam * self.cos_beam).max(0.0).sqrt() / self.cos_beam;
-            let radius = side * tan;
+            let radius = side * beam.tan;
             if PI * radius * radius < self.area && radius > 0.0 && radius.is_finite() {
                 let foot = p - self.frame.n * side;
                 return Some(Strategy::Beam { foot, radius });

@@ -41,13 +41,10 @@ impl Scene {
     /// absorption and the `t` term, and forces the chosen effects. `by` names where the knobs
     /// came from (`command line`, `render.accuracy`), for `lapidary info`.
     ///
-    /// Fails (changing nothing) when an effect this version cannot simulate is forced on.
+    /// Every effect can be forced either way since issue 20 (the last slot for later work,
+    /// fluorescence, is simulated), so this does not fail today; the `Result` stays for knobs a
+    /// scene may refuse.
     pub fn set_accuracy(&mut self, acc: &Accuracy, by: &str) -> Result<(), KnobError> {
-        if let Some((e, _)) = acc.effects.iter().find(|(e, on)| *on && !e.implemented()) {
-            return Err(KnobError(format!(
-                "{e} cannot be forced on: this version does not simulate it"
-            )));
-        }
         if acc.is_default() {
             return Ok(());
         }

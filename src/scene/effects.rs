@@ -23,7 +23,7 @@ pub enum Effect {
     /// Spectral transport: four wavelengths per path (hero-wavelength sampling), measured spectra,
     /// spectral metals, dispersion (issue 19).
     Spectral,
-    /// Fluorescence, course §5.2.2 (later work).
+    /// Fluorescence, course §5.2.2 (issue 20): a used material whose Lambert base fluoresces.
     Fluorescence,
     /// Thin-lens depth of field (a camera `aperture > 0`).
     DepthOfField,
@@ -78,12 +78,6 @@ impl Effect {
             Effect::DepthOfField => "depth-of-field",
             Effect::EnvironmentImportance => "environment-importance",
         }
-    }
-
-    /// Whether this version can simulate the effect at all (the others are slots for later work:
-    /// no recipe element turns them on yet).
-    pub fn implemented(self) -> bool {
-        true
     }
 
     /// What turns the effect on.

@@ -1,5 +1,5 @@
-//! Effects of the stage — `depth-of-field`, `environment-importance` — and the effects this
-//! version does not simulate (module docs of tests/effects.rs).
+//! Effects of the stage — `depth-of-field`, `environment-importance` — and `fluorescence`, free
+//! where no base fluoresces (module docs of tests/effects.rs).
 
 use super::*;
 
@@ -102,9 +102,9 @@ fn environment_importance_forced_off_samples_the_map_uniformly() {
 }
 
 #[test]
-fn effects_this_version_does_not_simulate_cannot_be_forced_on() {
-    // A scene that calls for every implemented effect but environment importance: forcing a
-    // later-work slot off touches none of them.
+fn fluorescence_code_changes_nothing_without_a_fluorescent_base() {
+    // A scene that calls for eight effects (not environment importance, spectral or
+    // fluorescence): fluorescence forced on or off touches none of them.
     let busy = scene(
         r#"(materials: {
                "body": (coats: [(ior: 1.5, roughness: 2.0, thickness: 1.0, tint: Rgb(0.9, 0.6, 0.8))],
@@ -128,35 +128,18 @@ fn effects_this_version_does_not_simulate_cannot_be_forced_on() {
         8,
         "the scene should call for eight effects: {called:?}"
     );
-    let auto = film(&busy);
-    for effect in Effect::ALL.into_iter().filter(|e| !e.implemented()) {
-        let mut s = busy.clone();
-        let mut acc = Accuracy::default();
-        acc.force(Effect::Absorption, false); // set first: must not be applied either
-        acc.force(effect, true);
-        let err = s.set_accuracy(&acc, "test").unwrap_err().0;
-        assert!(
-            err.contains("does not simulate") && err.contains(effect.name()),
-            "{effect}: {err}"
-        );
-        assert_eq!(s, busy, "{effect}: a refused knob changed the scene");
-        let knobs: Knobs = format!("{}=on", effect.name()).parse().unwrap();
-        let err = knobs.apply(&mut s, "test").unwrap_err().0;
-        assert!(err.contains("does not simulate"), "{effect}: {err}");
-        assert_eq!(s, busy);
-
-        assert_untouched(effect, "a scene calling for eight other effects", &busy);
-        let off = forced(&busy, effect, false);
-        assert!(called.iter().all(|e| off.effects.on(*e)));
-        let (n, first) = differences(&auto, &film(&off));
-        assert_eq!(n, 0, "{effect} forced off: {}", first.unwrap_or_default());
-    }
-    // Every effect is simulated since issue 20 (fluorescence was the last slot): its code, forced
-    // on and off in this busy scene without a fluorescent base, changes nothing.
-    assert!(Effect::ALL.iter().all(|e| e.implemented()));
     assert_untouched(
         Effect::Fluorescence,
         "a scene calling for eight other effects",
         &busy,
+    );
+    // Spectral transport (a dispersive diamond and a measured light): the path keeps its film
+    // wavelengths, draws no fluorescence slot and gathers without a remap.
+    let diamond = gem("brilliant-diamond.ron");
+    assert!(diamond.effects.on(Effect::Spectral));
+    assert_untouched(
+        Effect::Fluorescence,
+        "the spectral brilliant diamond",
+        &diamond,
     );
 }
