@@ -131,6 +131,9 @@ fn scenes() -> Vec<(Effect, Scene)> {
         (Effect::ManifoldNee, gem("tinted-glass-sphere.ron")),
         // A rough boundary: the walk through the stone needs a smooth one.
         (Effect::ManifoldCaustics, gem("milky-stone.ron")),
+        // No fluorescent base, in spectral transport (the dispersive diamond): the code is a
+        // flag test per hit and the film wavelengths a copy per path.
+        (Effect::Fluorescence, gem("brilliant-diamond.ron")),
     ]
 }
 

@@ -40,6 +40,20 @@ enum Outline {
     Disc { radius: f32 },
 }
 
+impl Outline {
+    /// Whether the point `(a, b)` of the light's plane (coordinates along `frame.s`, `frame.t`
+    /// from the centre) lies on the light, its outline grown by the relative `slack`.
+    #[inline(always)]
+    fn contains(&self, a: f32, b: f32, slack: f32) -> bool {
+        match *self {
+            Outline::Rect { hx, hy } => {
+                a.abs() <= hx * (1.0 + slack) && b.abs() <= hy * (1.0 + slack)
+            }
+            Outline::Disc { radius } => a * a + b * b <= (radius * (1.0 + slack)).powi(2),
+        }
+    }
+}
+
 /// A planar emitter with uniform radiance, built from a stage [`AreaLight`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Area {
@@ -233,13 +247,7 @@ impl Area {
         }
         let q = ray.at(t) - self.center;
         let (a, b) = (q.dot(self.frame.s), q.dot(self.frame.t));
-        let inside = match self.outline {
-            Outline::Rect { hx, hy } => {
-                a.abs() <= hx * (1.0 + slack) && b.abs() <= hy * (1.0 + slack)
-            }
-            Outline::Disc { radius } => a * a + b * b <= (radius * (1.0 + slack)).powi(2),
-        };
-        inside.then_some(t)
+        self.outline.contains(a, b, slack).then_some(t)
     }
 
     /// How `sample` draws directions from `p` (a function of `p` alone, so `pdf` can repeat the
@@ -326,11 +334,7 @@ impl Area {
                 let q = foot + self.frame.s * d.x + self.frame.t * d.y;
                 let local = q - self.center;
                 let (a, b) = (local.dot(self.frame.s), local.dot(self.frame.t));
-                let inside = match self.outline {
-                    Outline::Rect { hx, hy } => a.abs() <= hx && b.abs() <= hy,
-                    Outline::Disc { radius } => a * a + b * b <= radius * radius,
-                };
-                if !inside {
+                if !self.outline.contains(a, b, 0.0) {
                     return None;
                 }
                 let d = q - p;

@@ -25,6 +25,8 @@ pub struct Line {
     sigma: f32,
     /// Peak value (radiance per nm at the centre).
     scale: f32,
+    /// [`Line::support`], computed once.
+    support: (f32, f32),
 }
 
 impl Line {
@@ -34,17 +36,18 @@ impl Line {
             center,
             sigma: fwhm / (2.0 * (2.0 * std::f32::consts::LN_2).sqrt()),
             scale: 1.0,
+            support: (
+                (center - 2.0 * fwhm).max(super::cie::LAMBDA_MIN),
+                (center + 2.0 * fwhm).min(super::cie::LAMBDA_MAX),
+            ),
         }
     }
 
     /// The interval `[lo, hi]` that importance sampling draws from for this line: ±2 FWHM
     /// around the centre (99.99 % of the Gaussian's area), clipped to 360 ..= 830 nm.
+    #[inline]
     pub fn support(&self) -> (f32, f32) {
-        let half = 2.0 * self.sigma * 2.0 * (2.0 * std::f32::consts::LN_2).sqrt();
-        (
-            (self.center - half).max(super::cie::LAMBDA_MIN),
-            (self.center + half).min(super::cie::LAMBDA_MAX),
-        )
+        self.support
     }
 
     /// `L(λ)`.

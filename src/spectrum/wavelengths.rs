@@ -59,6 +59,17 @@ struct Constants {
     illuminant: Vec<f32>,
 }
 
+impl Constants {
+    /// The unit-luminance D65 at `l` nm (within 360 ..= 830), linear between the 1 nm values.
+    #[inline]
+    fn illuminant_at(&self, l: f32) -> f32 {
+        let x = l - LAMBDA_MIN;
+        let j = (x as usize).min(self.illuminant.len() - 2);
+        let f = x - j as f32;
+        self.illuminant[j] + f * (self.illuminant[j + 1] - self.illuminant[j])
+    }
+}
+
 fn constants() -> &'static Constants {
     static C: LazyLock<Constants> = LazyLock::new(|| {
         let (t0, span) = range();
@@ -157,10 +168,7 @@ impl HeroWavelengths {
                 .clamp(LAMBDA_MIN, LAMBDA_MAX);
             w.lambda[i] = l;
             w.pdf[i] = (1.0 - y * y) * c.pdf_scale;
-            let x = l - LAMBDA_MIN;
-            let j = (x as usize).min(c.illuminant.len() - 2);
-            let f = x - j as f32;
-            w.illuminant[i] = c.illuminant[j] + f * (c.illuminant[j + 1] - c.illuminant[j]);
+            w.illuminant[i] = c.illuminant_at(l);
         }
         w
     }
@@ -196,13 +204,9 @@ impl HeroWavelengths {
     /// Carries wavelength `i` at `lambda` nm from here on (a fluorescent re-radiation's excitation
     /// wavelength): its D65 value follows; its density (the film's) is left as drawn.
     pub fn set(&mut self, i: usize, lambda: f32) {
-        let c = constants();
         let l = lambda.clamp(LAMBDA_MIN, LAMBDA_MAX);
         self.lambda[i] = l;
-        let x = l - LAMBDA_MIN;
-        let j = (x as usize).min(c.illuminant.len() - 2);
-        let f = x - j as f32;
-        self.illuminant[i] = c.illuminant[j] + f * (c.illuminant[j + 1] - c.illuminant[j]);
+        self.illuminant[i] = constants().illuminant_at(l);
     }
 
     /// Keeps only the hero wavelength (module docs); does nothing if already done.
