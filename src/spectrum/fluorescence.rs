@@ -271,19 +271,22 @@ impl Fluorescence {
             let mut primary = [0.0f32; 3];
             primary[k] = 1.0;
             let (scale, s) = rgb2spec::illuminant(primary);
-            let incident: Vec<f32> = (0..CELLS)
-                .map(|j| {
-                    let l = LAMBDA_MIN + j as f32 + 0.5;
-                    scale * s.eval(l) * rgb2spec::d65_normalised(l)
-                })
-                .collect();
-            // The re-emitted spectrum on the CMF grid (1 nm sums over λi).
+            // The kernel separates, `K = Q e(λo)/λo · a(λi) λi [λi ≤ λo]`: the re-emitted
+            // spectrum is `Q e(λo)/λo` times a prefix sum over the excitation cells (1 nm sums
+            // over λi), so each column costs one pass instead of one per output wavelength.
+            let mut prefix = Vec::with_capacity(CELLS + 1);
+            let mut acc = 0.0f64;
+            prefix.push(0.0);
+            for j in 0..CELLS {
+                let l = LAMBDA_MIN + j as f32 + 0.5;
+                let li = scale * s.eval(l) * rgb2spec::d65_normalised(l);
+                acc += f64::from(li) * f64::from(self.excitation[j]) * f64::from(l);
+                prefix.push(acc);
+            }
             let out = |lo: f32| -> f32 {
-                incident
-                    .iter()
-                    .enumerate()
-                    .map(|(j, &li)| li * self.kernel(LAMBDA_MIN + j as f32 + 0.5, lo))
-                    .sum()
+                // Cells whose centre is at or below λo.
+                let n = ((lo - LAMBDA_MIN - 0.5).floor() + 1.0).clamp(0.0, CELLS as f32) as usize;
+                (f64::from(self.quantum_yield * self.emission(lo) / lo) * prefix[n]) as f32
             };
             let rgb = cie::xyz_to_linear_srgb(cie::spectrum_to_xyz(out));
             // An RGB render carries non-negative channels: a re-emission outside the sRGB gamut
@@ -449,5 +452,29 @@ mod tests {
         // the green one.
         assert!(m.iter().flatten().all(|v| v.is_finite()), "{m:?}");
         assert!(m[0][2] < m[0][1], "{m:?}");
+        // Each column against the kernel integrated directly (a double sum over 1 nm cells of
+        // λi and the CMF grid of λo), independent of the prefix sums the matrix uses.
+        for k in 0..3 {
+            let mut primary = [0.0f32; 3];
+            primary[k] = 1.0;
+            let (scale, s) = rgb2spec::illuminant(primary);
+            let out = |lo: f32| -> f32 {
+                (0..CELLS)
+                    .map(|j| {
+                        let l = LAMBDA_MIN + j as f32 + 0.5;
+                        scale * s.eval(l) * rgb2spec::d65_normalised(l) * f.kernel(l, lo)
+                    })
+                    .sum()
+            };
+            let rgb = cie::xyz_to_linear_srgb(cie::spectrum_to_xyz(out)).to_array();
+            for c in 0..3 {
+                let want = rgb[c].max(0.0);
+                assert!(
+                    (m[c][k] - want).abs() <= 1e-4 * want.abs().max(1e-3),
+                    "M[{c}][{k}] = {} vs {want}",
+                    m[c][k]
+                );
+            }
+        }
     }
 }
