@@ -400,7 +400,7 @@ fn a_render_needing_more_memory_than_allowed_is_refused_with_the_figure() {
     let err = text_of(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(
-        err.contains("the render needs 17.0 GiB, 8.0 GiB allowed (film 17.0 GiB)"),
+        err.contains("the render needs 25.0 GiB, 8.0 GiB allowed (film 25.0 GiB)"),
         "{err}"
     );
     // Beyond the largest image (2^26 pixels) the size itself is refused, with the range.
@@ -412,7 +412,7 @@ fn a_render_needing_more_memory_than_allowed_is_refused_with_the_figure() {
     let out = render(&["--size", "1024x1024", "--max-memory", "200M"]);
     let err = text_of(&out.stderr);
     assert!(
-        err.contains("the render needs 288.0 MiB, 200.0 MiB allowed"),
+        err.contains("the render needs 416.0 MiB, 200.0 MiB allowed"),
         "{err}"
     );
     let out = render(&["--size", "64x64", "--max-memory", "200M"]);

@@ -108,28 +108,28 @@ const FIELDS: [&str; 18] = [
     "rays",
 ];
 
-/// Every field of a pixel as raw bits.
-fn bits(p: &PixelSums) -> [u64; 18] {
-    let f = |v: f64| v.to_bits();
+/// Every field of a pixel as raw bits (the film's sums are fixed-point integers).
+fn bits(p: &PixelSums) -> [u128; 18] {
+    let w = |v: i64| u128::from(v as u64);
     [
-        f(p.sum[0]),
-        f(p.sum[1]),
-        f(p.sum[2]),
-        f(p.sum_sq[0]),
-        f(p.sum_sq[1]),
-        f(p.sum_sq[2]),
-        f(p.albedo[0]),
-        f(p.albedo[1]),
-        f(p.albedo[2]),
-        f(p.normal[0]),
-        f(p.normal[1]),
-        f(p.normal[2]),
-        f(p.depth),
-        u64::from(p.n),
-        u64::from(p.dropped),
-        u64::from(p.depth_n),
-        u64::from(p.material as u32),
-        p.rays,
+        p.sum[0] as u128,
+        p.sum[1] as u128,
+        p.sum[2] as u128,
+        p.sum_sq[0],
+        p.sum_sq[1],
+        p.sum_sq[2],
+        w(p.albedo[0]),
+        w(p.albedo[1]),
+        w(p.albedo[2]),
+        w(p.normal[0]),
+        w(p.normal[1]),
+        w(p.normal[2]),
+        p.depth as u128,
+        u128::from(p.n),
+        u128::from(p.dropped),
+        u128::from(p.depth_n),
+        u128::from(p.material as u32),
+        u128::from(p.rays),
     ]
 }
 

@@ -227,23 +227,23 @@ pub fn ray(o: Vec3, d: Vec3) -> Ray {
     Ray::new(o, d.normalize())
 }
 
-/// Every field of a pixel as raw bits (`PartialEq` on `f64` would take `-0.0 == 0.0`).
-fn bits(p: &PixelSums) -> Vec<u64> {
-    let mut v: Vec<u64> = p
-        .sum
-        .iter()
-        .chain(&p.sum_sq)
-        .chain(&p.albedo)
-        .chain(&p.normal)
-        .chain(std::iter::once(&p.depth))
-        .map(|x| x.to_bits())
-        .collect();
+/// Every field of a pixel (the film's sums are fixed-point integers, so equality is exact).
+fn bits(p: &PixelSums) -> Vec<u128> {
+    let mut v: Vec<u128> = p.sum.iter().map(|&x| x as u128).collect();
+    v.extend(p.sum_sq);
+    v.extend(
+        p.albedo
+            .iter()
+            .chain(&p.normal)
+            .map(|&x| u128::from(x as u64)),
+    );
     v.extend([
-        u64::from(p.n),
-        u64::from(p.dropped),
-        u64::from(p.depth_n),
-        u64::from(p.material as u32),
-        p.rays,
+        p.depth as u128,
+        u128::from(p.n),
+        u128::from(p.dropped),
+        u128::from(p.depth_n),
+        u128::from(p.material as u32),
+        u128::from(p.rays),
     ]);
     v
 }

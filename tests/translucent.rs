@@ -123,9 +123,10 @@ impl Acc {
     /// Adds a film pixel's sums.
     pub fn add_pixel(&mut self, p: &PixelSums) {
         self.n += u64::from(p.n);
+        let (sum, sq) = (p.radiance_sum(), p.radiance_sq_sum());
         for c in 0..3 {
-            self.sum[c] += p.sum[c];
-            self.sq[c] += p.sum_sq[c];
+            self.sum[c] += sum[c];
+            self.sq[c] += sq[c];
         }
     }
 

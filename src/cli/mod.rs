@@ -21,10 +21,12 @@ macro_rules! outln {
 pub mod brdf;
 pub mod check;
 pub mod compare;
+pub mod farm;
 pub mod info;
 pub mod knobs;
 pub mod load;
 pub mod map;
+pub mod merge;
 pub mod plot;
 pub mod regress;
 pub mod render;
@@ -64,6 +66,14 @@ pub enum Command {
     /// Path-trace a gem recipe to NAME.exr (colour, AOVs, metadata) and NAME.png. Ctrl-C or
     /// --time-limit stop early and write what was rendered, marked partial (Ctrl-C exits 130).
     Render(render::RenderArgs),
+    /// Merge part renders (`render --samples A..B`) into the render of the whole range: checks
+    /// they belong together and cover every sample once; the result equals a one-machine
+    /// render bit for bit.
+    Merge(merge::MergeArgs),
+    /// Split a render over a cluster: `farm slurm RECIPE --parts N` writes (and with --submit
+    /// submits) a Slurm job array of part renders and a merge job after it; re-running it
+    /// renders only the parts still missing.
+    Farm(farm::FarmArgs),
     /// Compare a test render with a reference (EXR): RMSE, relMSE, MAE, PSNR and a per-pixel
     /// z-test; exits 0 on pass, 1 on fail, 2 on unusable input.
     Compare(compare::CompareArgs),
@@ -84,6 +94,8 @@ pub fn run() -> ExitCode {
         Command::Map(args) => map::run(&args),
         Command::Info(args) => info::run(&args),
         Command::Tradeoff(args) => tradeoff::run(&args),
+        Command::Merge(args) => merge::run(&args),
+        Command::Farm(args) => farm::run(&args),
         Command::Render(args) => match render::run(&args) {
             Ok(false) => Ok(()),
             Ok(true) => return ExitCode::from(130),
@@ -99,6 +111,7 @@ pub fn run() -> ExitCode {
                 }
             };
         }
+        Command::Regress(args) if args.farm.farm.is_some() => farm::regress::run(&args),
         Command::Regress(args) => {
             return match regress::run(&args) {
                 Ok(regress::Outcome::Pass) => ExitCode::SUCCESS,

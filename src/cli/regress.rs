@@ -52,6 +52,20 @@ pub struct RegressArgs {
     /// Worker threads (default: one per core).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1024))]
     pub threads: Option<u32>,
+    /// Run only the recipe with this name (`NAME` of `NAME.ron`).
+    #[arg(long, value_name = "NAME")]
+    pub only: Option<String>,
+    /// A folder of test renders (`NAME.exr`): with `--render-only` they are written there;
+    /// without, they are read from there instead of rendered (how a farm's table is made).
+    #[arg(long, value_name = "DIR")]
+    pub renders: Option<PathBuf>,
+    /// Only render the test renders into `--renders`, without comparing.
+    #[arg(long, requires = "renders", conflicts_with = "update")]
+    pub render_only: bool,
+    /// Split the suite over a cluster: one array task per recipe, then the table (see
+    /// `lapidary farm`).
+    #[command(flatten)]
+    pub farm: super::farm::args::RegressFarmArgs,
 }
 
 /// Outcome of `lapidary regress`.
@@ -163,9 +177,88 @@ fn planned_outputs(args: &RegressArgs, list: &[PathBuf]) -> Result<Vec<Vec<PathB
         .collect()
 }
 
-/// Runs `lapidary regress`.
-pub fn run(args: &RegressArgs) -> Result<Outcome> {
+/// The recipe's name (`NAME` of `NAME.ron`).
+pub fn stem(recipe: &Path) -> String {
+    recipe
+        .file_stem()
+        .unwrap_or_default()
+        .to_string_lossy()
+        .into_owned()
+}
+
+/// The suite's recipes, or only the one `--only` names.
+pub fn selected(args: &RegressArgs) -> Result<Vec<PathBuf>> {
     let list = recipes(&args.dir)?;
+    match &args.only {
+        None => Ok(list),
+        Some(name) => {
+            let one: Vec<PathBuf> = list.iter().filter(|r| stem(r) == *name).cloned().collect();
+            if one.is_empty() {
+                bail!(
+                    "--only {name}: no {name}.ron in {} (it has {})",
+                    args.dir.display(),
+                    list.iter().map(|r| stem(r)).collect::<Vec<_>>().join(", ")
+                );
+            }
+            Ok(one)
+        }
+    }
+}
+
+/// Whether a stored test render is what this run would render of `recipe` (hash, spp, seed).
+pub fn render_matches(img: &ExrImage, recipe_hash: u64, spp: u32, seed: u64) -> Result<(), String> {
+    for (key, want) in [
+        ("lapidary.recipe_hash", format!("{recipe_hash:016x}")),
+        ("lapidary.spp", spp.to_string()),
+        ("lapidary.seed", seed.to_string()),
+        ("lapidary.sampler", "independent".to_string()),
+    ] {
+        let have = img.attribute(key).unwrap_or("(none)");
+        if have != want {
+            return Err(format!("its `{key}` is {have}, not {want}"));
+        }
+    }
+    Ok(())
+}
+
+/// The test render of `recipe`: read from `--renders` when given (and not `--render-only`),
+/// else rendered. Returns it with its render time in seconds.
+fn test_render(args: &RegressArgs, recipe: &Path, reference: &ExrImage) -> Result<(ExrImage, f64)> {
+    if let (Some(dir), false) = (&args.renders, args.render_only) {
+        let path = dir.join(format!("{}.exr", stem(recipe)));
+        let img = read_exr(&path)?;
+        let hash = super::load::load_scene(recipe, &Accuracy::default(), None)?
+            .scene
+            .hash;
+        render_matches(&img, hash, args.spp, args.seed)
+            .map_err(|e| anyhow!("{}: stale test render: {e}", path.display()))?;
+        if (img.width, img.height) != (reference.width, reference.height) {
+            bail!("{}: not the reference's size", path.display());
+        }
+        let secs = img
+            .attribute("lapidary.render_time")
+            .and_then(|t| t.parse().ok())
+            .unwrap_or(0.0);
+        return Ok((img, secs));
+    }
+    let start = Instant::now();
+    let img = render_recipe(
+        recipe,
+        Some((reference.width, reference.height)),
+        args.spp,
+        args.seed,
+        SamplerKind::Independent,
+        args.threads,
+    )?;
+    Ok((img, start.elapsed().as_secs_f64()))
+}
+
+/// Runs `lapidary regress` here (`--farm` is dispatched by [`super::run`] to the farm).
+pub fn run(args: &RegressArgs) -> Result<Outcome> {
+    let list = selected(args)?;
+    if args.render_only {
+        return render_only(args, &list);
+    }
     let files = planned_outputs(args, &list)?;
     let mut outcome = Outcome::Pass;
     if args.update {
@@ -216,23 +309,14 @@ pub fn run(args: &RegressArgs) -> Result<Outcome> {
                 continue;
             }
         };
-        let start = Instant::now();
-        let test = match render_recipe(
-            recipe,
-            Some((reference.width, reference.height)),
-            args.spp,
-            args.seed,
-            SamplerKind::Independent,
-            args.threads,
-        ) {
+        let (test, secs) = match test_render(args, recipe, &reference) {
             Ok(t) => t,
             Err(e) => {
-                outln!("{name:<24} unusable: {e}");
+                outln!("{name:<24} unusable: {e:#}");
                 outcome = Outcome::Unusable;
                 continue;
             }
         };
-        let secs = start.elapsed().as_secs_f64();
         let options = Options {
             mean_tolerance: args.mean_tolerance,
         };
@@ -281,6 +365,43 @@ pub fn run(args: &RegressArgs) -> Result<Outcome> {
     }
     tally.unusable = list.len() - tally.passed - tally.failed;
     outln!("{}", tally.summary());
+    Ok(outcome)
+}
+
+/// `--render-only`: renders each recipe at its reference's size into `--renders`.
+fn render_only(args: &RegressArgs, list: &[PathBuf]) -> Result<Outcome> {
+    use crate::image::outputs::{Format, OutputPlan};
+    let Some(dir) = &args.renders else {
+        bail!("--render-only needs --renders DIR");
+    };
+    std::fs::create_dir_all(dir).map_err(|e| anyhow!("{}: {e}", dir.display()))?;
+    let mut plan = OutputPlan::new();
+    for recipe in list {
+        plan.input(recipe, "the recipe")?;
+        plan.input(&recipe.with_extension("exr"), "the reference")?;
+    }
+    plan.folder(dir)?;
+    let mut outcome = Outcome::Pass;
+    for recipe in list {
+        let name = stem(recipe);
+        let file = plan.output_in(dir, &format!("{name}.exr"), Format::Exr)?;
+        let made = read_exr(&recipe.with_extension("exr"))
+            .map_err(anyhow::Error::from)
+            .and_then(|reference| test_render(args, recipe, &reference));
+        match made {
+            Ok((img, secs)) => {
+                write_exr(&file, &img)?;
+                outln!(
+                    "{name}: test render written to {} in {secs:.1} s",
+                    file.display()
+                );
+            }
+            Err(e) => {
+                outln!("{name}: unusable: {e:#}");
+                outcome = Outcome::Unusable;
+            }
+        }
+    }
     Ok(outcome)
 }
 

@@ -7,7 +7,8 @@
 
 use crate::image::atomic::{abort_process, all_or_nothing};
 use crate::image::outputs::{Format, OutputPlan};
-use crate::image::{Curve, ToneMap, write_exr, write_png};
+use crate::image::{Curve, ToneMap, write_exr, write_exr_raw, write_png};
+use crate::render::part::{PartSettings, part_image};
 use crate::render::{Control, Metadata, Rendered, Strategy, exr_image, render_scene};
 use crate::scene::stage::SamplerKind;
 use crate::scene::{Effect, Scene};
@@ -36,6 +37,11 @@ pub struct RenderArgs {
     /// Samples per pixel (default: the recipe's, else 64).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_048_576))]
     pub spp: Option<u32>,
+    /// Render only samples `A..B` of every pixel (of the render's `--spp`) and write a part file:
+    /// the EXR of those samples with their exact sums, for `lapidary merge` (docs/farm.md). No
+    /// PNG unless `--png` names one.
+    #[arg(long, value_name = "A..B", value_parser = crate::render::part::parse_range)]
+    pub samples: Option<std::ops::Range<u32>>,
     /// Image size `WxH` in pixels (default: the recipe's, else 640x480).
     #[arg(long, value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
@@ -112,6 +118,17 @@ pub enum StrategyArg {
     Bsdf,
 }
 
+impl StrategyArg {
+    /// The value as written on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            StrategyArg::Mis => "mis",
+            StrategyArg::Light => "light",
+            StrategyArg::Bsdf => "bsdf",
+        }
+    }
+}
+
 pub(crate) fn parse_size(s: &str) -> Result<(u32, u32), String> {
     use crate::scene::stage::{MAX_PIXELS, MAX_SIDE};
     let err = || {
@@ -177,7 +194,7 @@ fn outputs(args: &RenderArgs) -> Result<(PathBuf, Option<PathBuf>)> {
             PathBuf::from(stem).with_extension("exr")
         }
     };
-    let png = if args.no_png {
+    let png = if args.no_png || (args.samples.is_some() && args.png.is_none()) {
         None
     } else {
         Some(
@@ -266,8 +283,19 @@ pub fn run(args: &RenderArgs) -> Result<bool> {
         eprintln!("warning: {}: {w}", args.recipe.display());
     }
     let r = scene.stage.render;
-
-    let total = u64::from(r.width) * u64::from(r.height) * u64::from(r.spp);
+    if let Some(range) = &args.samples
+        && range.end > r.spp
+    {
+        bail!(
+            "--samples {}: goes past the render's {} spp (its samples are 0..{}; set --spp for \
+             the whole render)",
+            crate::render::part::format_range(range),
+            r.spp,
+            r.spp
+        );
+    }
+    let spp_here = args.samples.as_ref().map_or(r.spp, |s| s.end - s.start);
+    let total = u64::from(r.width) * u64::from(r.height) * u64::from(spp_here);
     let bar = if args.quiet {
         ProgressBar::hidden()
     } else {
@@ -292,6 +320,7 @@ pub fn run(args: &RenderArgs) -> Result<bool> {
         cancel: Some(cancel),
         progress: Some(&progress),
         on_pass: None,
+        samples: args.samples.clone(),
     };
     let rendered = render_scene(&world, &scene, &control);
     bar.finish_and_clear();
@@ -315,8 +344,19 @@ pub fn run(args: &RenderArgs) -> Result<bool> {
     let meta = Metadata::of(&args.recipe.display().to_string(), &scene);
     // Both files or neither: a PNG that cannot be written leaves the old EXR in place.
     all_or_nothing(|| {
-        write_exr(&exr_file, &exr_image(&rendered, &meta))
-            .with_context(|| format!("writing {}", exr_path.display()))?;
+        match &args.samples {
+            Some(requested) => {
+                let part = PartSettings {
+                    requested: requested.clone(),
+                    strategy: args.strategy.name().to_string(),
+                    exposure: r.exposure,
+                };
+                let (img, raw) = part_image(&rendered, &meta, &part);
+                write_exr_raw(&exr_file, &img, &raw)
+            }
+            None => write_exr(&exr_file, &exr_image(&rendered, &meta)),
+        }
+        .with_context(|| format!("writing {}", exr_path.display()))?;
         if let (Some(png), Some(shown)) = (&png_file, &png_path) {
             let tm = ToneMap {
                 exposure: r.exposure,
@@ -381,6 +421,13 @@ fn summary(
         set.max_depth,
         secs
     );
+    if let Some(range) = &args.samples {
+        out += &format!(
+            "  part: samples {} of 0..{} (merge the parts with `lapidary merge`)\n",
+            crate::render::part::format_range(&(range.start..range.start + s.spp_complete)),
+            set.spp
+        );
+    }
     if s.partial {
         let why = if interrupted {
             "Ctrl-C or SIGTERM"

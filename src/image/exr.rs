@@ -12,7 +12,7 @@
 //! the string ones, plus `float`, `double`, `int` and string-vector ones formatted as text;
 //! they come back sorted by key. Bytes that are not UTF-8 are read as Latin-1.
 
-use super::{Channel, ExrImage, ImageError};
+use super::{Channel, ExrImage, ImageError, RawChannel};
 use ::exr::meta::header::standard_names;
 use ::exr::prelude::{
     AnyChannel, AnyChannels, AttributeValue, Encoding, Error as ExrError, FlatSamples, Image,
@@ -81,6 +81,11 @@ const STANDARD_TEXT: [(&str, TextField); 8] = [
 /// Writes `img` as a single-part, all-`f32`, ZIP-compressed EXR, atomically (see
 /// [`super::write_atomically`]): on error an existing file at `path` is left as it was.
 pub fn write_exr(path: &Path, img: &ExrImage) -> Result<(), ImageError> {
+    write_exr_raw(path, img, &[])
+}
+
+/// Writes `img` plus `raw` as 32-bit unsigned integer channels (exact), like [`write_exr`].
+pub fn write_exr_raw(path: &Path, img: &ExrImage, raw: &[RawChannel]) -> Result<(), ImageError> {
     let invalid = |reason: String| ImageError::Invalid {
         path: path.into(),
         reason,
@@ -94,21 +99,29 @@ pub fn write_exr(path: &Path, img: &ExrImage) -> Result<(), ImageError> {
     let n = img.width as usize * img.height as usize;
     let mut seen = HashSet::new();
     let mut list = SmallVec::new();
-    for c in &img.channels {
-        if c.data.len() != n {
+    let all = img
+        .channels
+        .iter()
+        .map(|c| (&c.name, c.data.len(), FlatSamples::F32(c.data.clone())))
+        .chain(
+            raw.iter()
+                .map(|c| (&c.name, c.data.len(), FlatSamples::U32(c.data.clone()))),
+        );
+    for (cname, len, samples) in all {
+        if len != n {
             return Err(ImageError::SizeMismatch {
                 path: path.into(),
-                what: format!("channel `{}`", c.name),
-                len: c.data.len(),
+                what: format!("channel `{cname}`"),
+                len,
                 width: img.width,
                 height: img.height,
             });
         }
-        let name = name_text(&c.name).ok_or_else(|| invalid(bad_name("channel", &c.name)))?;
-        if !seen.insert(c.name.as_str()) {
-            return Err(invalid(format!("duplicate channel `{}`", c.name)));
+        let name = name_text(cname).ok_or_else(|| invalid(bad_name("channel", cname)))?;
+        if !seen.insert(cname.as_str()) {
+            return Err(invalid(format!("duplicate channel `{cname}`")));
         }
-        list.push(AnyChannel::new(name, FlatSamples::F32(c.data.clone())));
+        list.push(AnyChannel::new(name, samples));
     }
     let mut attrs = LayerAttributes::default();
     seen.clear();
@@ -145,6 +158,12 @@ pub fn write_exr(path: &Path, img: &ExrImage) -> Result<(), ImageError> {
 
 /// Reads the first flat layer of an EXR: all channels as `f32`, text attributes sorted by key.
 pub fn read_exr(path: &Path) -> Result<ExrImage, ImageError> {
+    read_exr_raw(path).map(|(img, _)| img)
+}
+
+/// Reads like [`read_exr`], and also returns the `UINT` channels exactly (they are in the image
+/// too, converted to `f32`).
+pub fn read_exr_raw(path: &Path) -> Result<(ExrImage, Vec<RawChannel>), ImageError> {
     // The header alone first: clear errors for missing, foreign and deep-only files.
     let meta = MetaData::read_from_file(path, false).map_err(|e| decode_error(path, e))?;
     if !meta.headers.is_empty() && meta.headers.iter().all(|h| h.deep) {
@@ -175,12 +194,20 @@ pub fn read_exr(path: &Path) -> Result<ExrImage, ImageError> {
         });
     };
     let mut channels = Vec::with_capacity(layer.channel_data.list.len());
+    let mut raw = Vec::new();
     for c in layer.channel_data.list {
         let name = decode_text(&c.name);
         let data: Vec<f32> = match c.sample_data {
             FlatSamples::F32(v) => v,
             FlatSamples::F16(v) => v.iter().map(|x| x.to_f32()).collect(),
-            FlatSamples::U32(v) => v.iter().map(|&x| x as f32).collect(),
+            FlatSamples::U32(v) => {
+                let f = v.iter().map(|&x| x as f32).collect();
+                raw.push(RawChannel {
+                    name: name.clone(),
+                    data: v,
+                });
+                f
+            }
         };
         if data.len() != w * h {
             return Err(ImageError::Unsupported {
@@ -202,12 +229,13 @@ pub fn read_exr(path: &Path) -> Result<ExrImage, ImageError> {
     let other = layer.attributes.other.iter().chain(&image.attributes.other);
     attributes.extend(other.filter_map(|(k, v)| Some((decode_text(k), attribute_text(v)?))));
     attributes.sort();
-    Ok(ExrImage {
+    let img = ExrImage {
         width,
         height,
         channels,
         attributes,
-    })
+    };
+    Ok((img, raw))
 }
 
 /// Reads `R`, `G`, `B` (alpha and other channels ignored; a lone `Y` gives grey) from the first

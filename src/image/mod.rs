@@ -33,7 +33,7 @@ pub mod stats;
 
 pub use self::atomic::write_atomically;
 pub use self::compare::{CompareError, Comparison, ZTest, compare};
-pub use self::exr::{RgbImage, read_exr, read_rgb, write_exr};
+pub use self::exr::{RgbImage, read_exr, read_exr_raw, read_rgb, write_exr, write_exr_raw};
 pub use self::heatmap::write_heatmap;
 pub use self::png::{Curve, ToneMap, tone_map_pixel, write_png};
 
@@ -59,6 +59,16 @@ pub struct ExrImage {
     pub channels: Vec<Channel>,
     /// Text metadata as `(key, value)` pairs, e.g. `("lapidary.spp", "64")`.
     pub attributes: Vec<(String, String)>,
+}
+
+/// A channel of exact 32-bit unsigned integers (OpenEXR's `UINT` type), for data that must
+/// round-trip bit for bit, such as a part render's fixed-point sums.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct RawChannel {
+    /// Full channel name (`"raw.sum.R.0"`).
+    pub name: String,
+    /// `width × height` words, row-major, top row first.
+    pub data: Vec<u32>,
 }
 
 impl Channel {

@@ -296,7 +296,7 @@ pub(crate) fn stage(
         errors.push(src.error(
             part_at("render"),
             format!(
-                "stage.render: {}x{} is {pixels} pixels; at most {} (8192x8192, about 18 GiB of \
+                "stage.render: {}x{} is {pixels} pixels; at most {} (8192x8192, about 25 GiB of \
                  film) — each side 1 ..= {}",
                 rs.width,
                 rs.height,

@@ -1,30 +1,39 @@
 //! The film: per-pixel sums of samples, from which the mean, the variance of the mean and the
-//! AOVs are read. Sums are `f64` and each pixel's samples are added in sample order by one thread,
-//! so the result does not depend on scheduling.
+//! AOVs are read.
+//!
+//! **Exact sums.** Every sum is a fixed-point integer (see [`super::fixed`]), so adding samples is
+//! associative and commutative: a pixel's sums do not depend on the order its samples were
+//! added, on the thread count, or on how its sample range was split into parts rendered on
+//! different machines and merged ([`PixelSums::merge`], `lapidary merge`). A render of samples
+//! `0..N` and the merge of renders of `0..k` and `k..N` are bit-identical.
 
+use super::fixed;
 use super::path::PathSample;
 use crate::spectrum::RgbSample;
 
-/// The accumulated samples of one pixel.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+/// The accumulated samples of one pixel. Sums are fixed-point integers ([`super::fixed`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct PixelSums {
-    /// Σ radiance per channel.
-    pub sum: [f64; 3],
-    /// Σ radiance² per channel.
-    pub sum_sq: [f64; 3],
+    /// Σ radiance per channel, in units of [`fixed::RADIANCE_UNIT`] (wrapping: exact while the
+    /// true sum fits, which it does for any count of samples a render accepts).
+    pub sum: [i128; 3],
+    /// Σ radiance² per channel, in units of [`fixed::SQUARE_UNIT`], saturating at `u128::MAX`.
+    pub sum_sq: [u128; 3],
     /// Samples kept.
     pub n: u32,
-    /// Samples dropped because their radiance was not finite (or negative).
+    /// Samples dropped because their radiance was not finite, negative, or beyond
+    /// [`fixed::RADIANCE_LIMIT`].
     pub dropped: u32,
-    /// Σ first-hit albedo.
-    pub albedo: [f64; 3],
-    /// Σ first-hit normal.
-    pub normal: [f64; 3],
-    /// Σ first-hit distance over samples that hit something, and their count.
-    pub depth: f64,
+    /// Σ first-hit albedo, in units of [`fixed::AOV_UNIT`].
+    pub albedo: [i64; 3],
+    /// Σ first-hit normal, in units of [`fixed::AOV_UNIT`].
+    pub normal: [i64; 3],
+    /// Σ first-hit distance over samples that hit something, in units of [`fixed::DEPTH_UNIT`].
+    pub depth: i128,
     /// Samples that hit something.
     pub depth_n: u32,
-    /// Material index of the pixel's first sample (−1 floor, −2 nothing), `i32::MIN` before any.
+    /// Material index of the pixel's lowest-numbered sample (−1 floor, −2 nothing), `i32::MIN`
+    /// before any.
     pub material: i32,
     /// Rays traced for the pixel.
     pub rays: u64,
@@ -33,33 +42,35 @@ pub struct PixelSums {
 impl PixelSums {
     /// An empty pixel.
     pub const EMPTY: PixelSums = PixelSums {
-        sum: [0.0; 3],
-        sum_sq: [0.0; 3],
+        sum: [0; 3],
+        sum_sq: [0; 3],
         n: 0,
         dropped: 0,
-        albedo: [0.0; 3],
-        normal: [0.0; 3],
-        depth: 0.0,
+        albedo: [0; 3],
+        normal: [0; 3],
+        depth: 0,
         depth_n: 0,
         material: i32::MIN,
         rays: 0,
     };
 
-    /// Adds one sample; a sample whose radiance is not finite and non-negative is dropped and
-    /// counted (its AOVs are kept: they are finite by construction).
+    /// Adds one sample; a sample whose radiance is not finite and non-negative (or beyond
+    /// [`fixed::RADIANCE_LIMIT`]) is dropped and counted (its AOVs are kept: they are finite by
+    /// construction). Samples must be added in increasing sample order within one film (the
+    /// material AOV keeps the first).
     pub fn add(&mut self, s: &PathSample) {
         self.rays += u64::from(s.rays);
         if self.material == i32::MIN {
             self.material = s.material;
         }
         for c in 0..3 {
-            self.albedo[c] += f64::from(s.albedo[c]);
+            self.albedo[c] = self.albedo[c].wrapping_add(fixed::aov(s.albedo[c]));
         }
         for (acc, v) in self.normal.iter_mut().zip(s.normal.to_array()) {
-            *acc += f64::from(v);
+            *acc = acc.wrapping_add(fixed::aov(v));
         }
         if let Some(t) = s.depth.filter(|t| t.is_finite()) {
-            self.depth += f64::from(t);
+            self.depth = self.depth.wrapping_add(fixed::depth(t));
             self.depth_n += 1;
         }
         let ok = if s.signed {
@@ -67,33 +78,68 @@ impl PixelSums {
         } else {
             s.radiance.is_valid()
         };
-        if !ok {
+        if !ok || s.radiance.0.iter().any(|v| v.abs() > fixed::RADIANCE_LIMIT) {
             self.dropped += 1;
             return;
         }
         self.n += 1;
         for c in 0..3 {
-            let v = f64::from(s.radiance[c]);
-            self.sum[c] += v;
-            self.sum_sq[c] += v * v;
+            let v = s.radiance[c];
+            self.sum[c] = self.sum[c].wrapping_add(fixed::radiance(v));
+            self.sum_sq[c] = self.sum_sq[c].saturating_add(fixed::square(v));
         }
+    }
+
+    /// Adds another part's sums of the same pixel: exact, so the result does not depend on the
+    /// order parts are merged in. `self` must hold the lower-numbered samples (it keeps its
+    /// material unless it has none).
+    pub fn merge(&mut self, other: &PixelSums) {
+        for c in 0..3 {
+            self.sum[c] = self.sum[c].wrapping_add(other.sum[c]);
+            self.sum_sq[c] = self.sum_sq[c].saturating_add(other.sum_sq[c]);
+            self.albedo[c] = self.albedo[c].wrapping_add(other.albedo[c]);
+            self.normal[c] = self.normal[c].wrapping_add(other.normal[c]);
+        }
+        self.n += other.n;
+        self.dropped += other.dropped;
+        self.depth = self.depth.wrapping_add(other.depth);
+        self.depth_n += other.depth_n;
+        if self.material == i32::MIN {
+            self.material = other.material;
+        }
+        self.rays += other.rays;
+    }
+
+    /// Σ radiance per channel as real numbers.
+    pub fn radiance_sum(&self) -> [f64; 3] {
+        self.sum.map(fixed::radiance_value)
+    }
+
+    /// Σ radiance² per channel as real numbers.
+    pub fn radiance_sq_sum(&self) -> [f64; 3] {
+        self.sum_sq.map(fixed::radiance_value_sq)
     }
 
     /// Mean radiance (0 without samples).
     pub fn mean(&self) -> RgbSample {
         let n = f64::from(self.n.max(1));
-        RgbSample(self.sum.map(|s| (s / n) as f32))
+        RgbSample(self.radiance_sum().map(|s| (s / n) as f32))
     }
 
     /// Variance of the mean per channel: the unbiased sample variance over `n` (0 below 2
-    /// samples).
+    /// samples; `f32::MAX` if the sum of squares saturated).
     pub fn variance_of_mean(&self) -> [f32; 3] {
         if self.n < 2 {
             return [0.0; 3];
         }
         let n = f64::from(self.n);
+        let sum = self.radiance_sum();
         std::array::from_fn(|c| {
-            let var = (self.sum_sq[c] - self.sum[c] * self.sum[c] / n) / (n - 1.0);
+            if self.sum_sq[c] == u128::MAX {
+                return f32::MAX;
+            }
+            let sq = fixed::radiance_value_sq(self.sum_sq[c]);
+            let var = (sq - sum[c] * sum[c] / n) / (n - 1.0);
             (var.max(0.0) / n) as f32
         })
     }
@@ -105,12 +151,13 @@ impl PixelSums {
 
     /// Mean first-hit albedo.
     pub fn mean_albedo(&self) -> [f32; 3] {
-        self.albedo.map(|a| (a / self.taken()) as f32)
+        self.albedo
+            .map(|a| (fixed::aov_value(a) / self.taken()) as f32)
     }
 
     /// Mean first-hit normal, renormalised (0 where nothing was hit).
     pub fn mean_normal(&self) -> [f32; 3] {
-        let v = self.normal;
+        let v = self.normal.map(fixed::aov_value);
         let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
         if len > 0.0 {
             v.map(|c| (c / len) as f32)
@@ -124,7 +171,7 @@ impl PixelSums {
         if self.depth_n == 0 {
             0.0
         } else {
-            (self.depth / f64::from(self.depth_n)) as f32
+            (fixed::depth_value(self.depth) / f64::from(self.depth_n)) as f32
         }
     }
 }

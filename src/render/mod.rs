@@ -4,20 +4,26 @@
 //! **Determinism.** Every random number is `hash(seed, pixel, sample, slot)` ([`PixelSampler`]);
 //! each pixel's samples are added in sample order by the one task that owns its tile in a pass,
 //! and passes run one after another. A render is therefore bit-identical for any thread count and
-//! any tile order.
+//! any tile order. The film's sums are fixed-point integers ([`fixed`]), exact and associative,
+//! so a render may also be split into sample ranges ([`Control::samples`]) rendered anywhere and
+//! merged ([`part`]) into the same film, bit for bit.
 //!
 //! **Stopping early.** A cancel flag or a deadline is checked before each tile; tiles not started
 //! are skipped, the render returns what was accumulated and says it is partial. Each pixel's
-//! sample count is kept (the `samples` AOV), so a partial image is still an unbiased mean.
+//! sample count is kept (the `samples` AOV), so a partial image is still an unbiased mean. A part
+//! render ([`Control::samples`]) keeps only complete passes, so it holds exactly the range it
+//! reports.
 
 pub mod camera;
 pub mod direct;
 pub mod film;
 pub mod filter;
+pub mod fixed;
 pub mod integrator;
 pub mod manifold;
 pub mod memory;
 pub mod output;
+pub mod part;
 pub mod path;
 pub mod setup;
 pub mod shading;
@@ -29,7 +35,7 @@ pub use direct::Strategy;
 pub use film::{Film, PixelSums};
 pub use filter::FilterSampler;
 pub use integrator::{trace, trace_at};
-pub use output::{Metadata, exr_image};
+pub use output::{Metadata, exr_image, film_channels};
 pub use path::{PathSample, PathState};
 pub use shading::{ShadingContext, SurfaceBsdf};
 pub use world::{World, WorldError};
@@ -66,6 +72,12 @@ pub struct Control<'a> {
     /// film then equals a render with that many spp, bit for bit (`lapidary tradeoff` takes its
     /// convergence curves this way).
     pub on_pass: Option<PassCallback<'a>>,
+    /// Render only these sample indices of every pixel (a part of a render split across
+    /// machines; `None`: all of `0..spp`). Sample `s` of a pixel is the same whichever range
+    /// renders it, and the film's sums are exact ([`film`]), so parts covering `0..spp` merge
+    /// into the one-machine render bit for bit. An empty or out-of-range end is clamped to
+    /// `spp`.
+    pub samples: Option<std::ops::Range<u32>>,
 }
 
 /// Figures of a finished (or stopped) render.
@@ -81,7 +93,8 @@ pub struct RenderStats {
     pub dropped: u64,
     /// Whether the render stopped before every pixel had all its samples.
     pub partial: bool,
-    /// Samples per pixel every pixel has (equal to the requested count unless partial).
+    /// Samples per pixel every pixel has (equal to the requested count, or the length of the
+    /// requested range, unless partial).
     pub spp_complete: u32,
 }
 
@@ -182,10 +195,15 @@ where
             || control.deadline.is_some_and(|d| Instant::now() >= d)
     };
     let step = pass_size(settings.spp);
-    let mut done = 0;
+    let last = control
+        .samples
+        .as_ref()
+        .map_or(settings.spp, |r| r.end.min(settings.spp));
+    let first = control.samples.as_ref().map_or(0, |r| r.start.min(last));
+    let mut done = first;
     let mut partial = false;
-    while done < settings.spp {
-        let end = (done + step).min(settings.spp);
+    while done < last {
+        let end = (done + step).min(last);
         let results: Vec<Option<Vec<PixelSums>>> = tiles
             .par_iter()
             .map(|&(x0, y0)| {
@@ -223,6 +241,13 @@ where
                 Some(sums)
             })
             .collect();
+        // A part (a sample range) must hold exactly the samples its range says: a pass stopped
+        // part way is dropped whole. A whole render keeps the finished tiles (the samples AOV
+        // counts them).
+        if control.samples.is_some() && results.iter().any(Option::is_none) {
+            partial = true;
+            break;
+        }
         for (&(x0, y0), sums) in tiles.iter().zip(results) {
             let Some(sums) = sums else {
                 partial = true;
@@ -243,8 +268,8 @@ where
         }
         done = end;
         if let Some(on_pass) = control.on_pass {
-            on_pass(&film, done);
+            on_pass(&film, done - first);
         }
     }
-    (film, partial, done)
+    (film, partial, done - first)
 }

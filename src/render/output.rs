@@ -73,31 +73,6 @@ impl Metadata {
 
 /// The EXR image of a render.
 pub fn exr_image(r: &Rendered, meta: &Metadata) -> ExrImage {
-    let px = &r.film.pixels;
-    let channel = |name: &str, f: &dyn Fn(&super::PixelSums) -> f32| Channel {
-        name: name.to_string(),
-        data: px.iter().map(f).collect(),
-    };
-    let mut channels = Vec::with_capacity(16);
-    for (c, name) in ["R", "G", "B"].iter().enumerate() {
-        channels.push(channel(name, &|p| p.mean()[c]));
-        channels.push(channel(&format!("albedo.{name}"), &|p| p.mean_albedo()[c]));
-        channels.push(channel(&format!("variance.{name}"), &|p| {
-            p.variance_of_mean()[c]
-        }));
-    }
-    for (c, name) in ["X", "Y", "Z"].iter().enumerate() {
-        channels.push(channel(&format!("normal.{name}"), &|p| p.mean_normal()[c]));
-    }
-    channels.push(channel("depth.Z", &|p| p.mean_depth()));
-    channels.push(channel("samples.Y", &|p| p.n as f32));
-    channels.push(channel("material.Y", &|p| {
-        if p.material == i32::MIN {
-            -2.0
-        } else {
-            p.material as f32
-        }
-    }));
     let s = &r.stats;
     let materials = meta
         .materials
@@ -135,7 +110,37 @@ pub fn exr_image(r: &Rendered, meta: &Metadata) -> ExrImage {
     ExrImage {
         width: r.film.width,
         height: r.film.height,
-        channels,
+        channels: film_channels(&r.film),
         attributes,
     }
+}
+
+/// The colour and AOV channels of a film (the table in the module documentation).
+pub fn film_channels(film: &super::Film) -> Vec<Channel> {
+    let px = &film.pixels;
+    let channel = |name: &str, f: &dyn Fn(&super::PixelSums) -> f32| Channel {
+        name: name.to_string(),
+        data: px.iter().map(f).collect(),
+    };
+    let mut channels = Vec::with_capacity(16);
+    for (c, name) in ["R", "G", "B"].iter().enumerate() {
+        channels.push(channel(name, &|p| p.mean()[c]));
+        channels.push(channel(&format!("albedo.{name}"), &|p| p.mean_albedo()[c]));
+        channels.push(channel(&format!("variance.{name}"), &|p| {
+            p.variance_of_mean()[c]
+        }));
+    }
+    for (c, name) in ["X", "Y", "Z"].iter().enumerate() {
+        channels.push(channel(&format!("normal.{name}"), &|p| p.mean_normal()[c]));
+    }
+    channels.push(channel("depth.Z", &|p| p.mean_depth()));
+    channels.push(channel("samples.Y", &|p| p.n as f32));
+    channels.push(channel("material.Y", &|p| {
+        if p.material == i32::MIN {
+            -2.0
+        } else {
+            p.material as f32
+        }
+    }));
+    channels
 }

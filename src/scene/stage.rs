@@ -164,8 +164,9 @@ pub enum Filter {
 }
 
 /// Most pixels of an image (8192² = 2²⁶). Each side may be up to [`MAX_SIDE`], but the film
-/// takes 272 bytes per pixel (see `render::memory`), so the largest accepted image needs about
-/// 18 GiB and renders on the project's 24 GiB machines; 16384² would need 68 GiB.
+/// takes 400 bytes per pixel (exact fixed-point sums; see `render::memory`), so the largest
+/// accepted image needs about 25 GiB: on the project's 24 GiB machines the memory check refuses
+/// it before rendering, and about 7500² fits; 16384² would need 100 GiB.
 pub const MAX_PIXELS: u64 = 1 << 26;
 /// Longest side of an image in pixels.
 pub const MAX_SIDE: u32 = 16384;

@@ -203,7 +203,7 @@ fn run(c: &Config, spp: u32, boundary: Boundary) -> Outcome {
     for y in 0..SIZE {
         for x in 0..SIZE {
             let p = &r.film.pixels[(y * SIZE + x) as usize];
-            let avg = p.sum.iter().sum::<f64>() / (3.0 * f64::from(p.n.max(1)));
+            let avg = p.radiance_sum().iter().sum::<f64>() / (3.0 * f64::from(p.n.max(1)));
             channel_mean_error = channel_mean_error.max((avg - 1.0).abs());
             blocks[((y / BLOCK) * nb + x / BLOCK) as usize].add_pixel(p);
             total.add_pixel(p);
