@@ -436,7 +436,8 @@ fn summary(
         };
         out += &format!(
             "  stopped by {why}: partial, {} of {} spp in every pixel (the EXR says so)\n",
-            s.spp_complete, set.spp
+            s.spp_complete,
+            args.samples.as_ref().map_or(set.spp, |r| r.end - r.start)
         );
     }
     out += &format!(

@@ -151,7 +151,10 @@ pub fn run(args: &SlurmArgs) -> Result<()> {
     // The parts' command, less the range: parts made by another command (other knobs through
     // --render-arg, another binary) are not this render's, whatever their headers say.
     let command_file = dir.join("parts").join("command.txt");
-    let command = render.join(" ") + "\n";
+    let command = format!(
+        "{MARKER}: the command of every part, less its range.\n{}\n",
+        render.join(" ")
+    );
     let same_command = std::fs::read_to_string(&command_file).is_ok_and(|c| c == command);
     if !same_command && command_file.exists() {
         outln!("the render command changed since the last run: every part is rendered again");
@@ -159,8 +162,7 @@ pub fn run(args: &SlurmArgs) -> Result<()> {
     let missing: Vec<u32> = (0..args.parts)
         .filter(|&i| !same_command || !done(&part_path(i), &ranges[i as usize], &expect))
         .collect();
-    std::fs::write(&command_file, &command)
-        .map_err(|e| anyhow!("{}: {e}", command_file.display()))?;
+    write_script(&command_file, &command)?;
     let ranges_text: Vec<String> = ranges.iter().map(format_range).collect();
     let array_script = dir.join("render.sbatch");
     write_script(

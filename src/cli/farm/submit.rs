@@ -9,7 +9,8 @@ use std::process::Command;
 /// overwritten.
 pub const MARKER: &str = "# Written by lapidary farm";
 
-/// Writes an executable script, replacing only a script this command wrote before.
+/// Writes an executable script (or the farm's record of its part command), replacing only a file
+/// this command wrote before: one whose first or second line is the [`MARKER`].
 pub fn write_script(path: &Path, text: &str) -> Result<()> {
     if let Ok(old) = std::fs::read_to_string(path) {
         if !old.lines().take(2).any(|l| l.starts_with(MARKER)) {
