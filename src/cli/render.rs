@@ -256,6 +256,17 @@ pub fn run(args: &RenderArgs) -> Result<bool> {
     let loaded = super::load::load_scene(&args.recipe, &args.knobs.accuracy(), Some(&mut plan))?;
     let mut scene = loaded.scene;
     settings(args, &mut scene);
+    // A range past the render's samples is refused before any setup.
+    let spp = scene.stage.render.spp;
+    if let Some(range) = &args.samples
+        && range.end > spp
+    {
+        bail!(
+            "--samples {}: goes past the render's {spp} spp (its samples are 0..{spp}; set --spp \
+             for the whole render)",
+            crate::render::part::format_range(range),
+        );
+    }
     let limit = args
         .max_memory
         .unwrap_or_else(crate::render::memory::default_limit);
@@ -283,17 +294,6 @@ pub fn run(args: &RenderArgs) -> Result<bool> {
         eprintln!("warning: {}: {w}", args.recipe.display());
     }
     let r = scene.stage.render;
-    if let Some(range) = &args.samples
-        && range.end > r.spp
-    {
-        bail!(
-            "--samples {}: goes past the render's {} spp (its samples are 0..{}; set --spp for \
-             the whole render)",
-            crate::render::part::format_range(range),
-            r.spp,
-            r.spp
-        );
-    }
     let spp_here = args.samples.as_ref().map_or(r.spp, |s| s.end - s.start);
     let total = u64::from(r.width) * u64::from(r.height) * u64::from(spp_here);
     let bar = if args.quiet {
