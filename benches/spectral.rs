@@ -146,6 +146,7 @@ fn bench(c: &mut Criterion<Clock>) {
         paired(&gems, pairs);
         return;
     }
+    bookkeeping(c);
     for path in gems {
         let name = path.file_stem().unwrap().to_string_lossy().to_string();
         let mut group = c.benchmark_group(format!("spectral/{name}"));
@@ -160,6 +161,34 @@ fn bench(c: &mut Criterion<Clock>) {
         }
         group.finish();
     }
+}
+
+/// A spectral path's fixed costs, per path: drawing its four wavelengths (the tabulated visible
+/// density, `src/spectrum/wavelengths.rs`) and projecting its estimate onto the film
+/// (`HeroSample::to_rgb`), each over a batch of 1024 stratified wavelength numbers.
+fn bookkeeping(c: &mut Criterion<Clock>) {
+    use lapidary::spectrum::wavelengths::HeroWavelengths;
+    use lapidary::spectrum::{HeroSample, Spectral};
+    let us: Vec<f32> = (0..1024).map(|i| (i as f32 + 0.5) / 1024.0).collect();
+    let lambdas: Vec<HeroWavelengths> = us.iter().map(|&u| HeroWavelengths::sample(u)).collect();
+    let mut group = c.benchmark_group("spectral/bookkeeping");
+    group.sample_size(20);
+    group.bench_function("wavelengths ×1024", |b| {
+        b.iter(|| {
+            for &u in &us {
+                black_box(HeroWavelengths::sample(black_box(u)));
+            }
+        })
+    });
+    let l = HeroSample([0.3, 0.5, 0.7, 0.2]);
+    group.bench_function("to_rgb ×1024", |b| {
+        b.iter(|| {
+            for w in &lambdas {
+                black_box(black_box(l).to_rgb(w));
+            }
+        })
+    });
+    group.finish();
 }
 
 fn config() -> Criterion<Clock> {

@@ -83,9 +83,9 @@ pub fn upsample<const N: usize>(rgb: [f32; 3], lambda: &[f32; N]) -> [f32; N] {
     }
     let t = &basis().0;
     lambda.map(|l| {
-        let x = (l - LAMBDA_MIN).clamp(0.0, (CMF_SAMPLES - 1) as f32);
-        let i = (x as usize).min(CMF_SAMPLES - 2);
-        let f = x - i as f32;
+        let x = l - LAMBDA_MIN;
+        let i = super::wavelengths::index(x, CMF_SAMPLES - 2);
+        let f = (x - i as f32).clamp(0.0, 1.0);
         let at = |k: usize| t[k][i] + f * (t[k][i + 1] - t[k][i]);
         lo + w2 * at(i2) + w1 * at(i1)
     })

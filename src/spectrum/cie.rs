@@ -79,6 +79,8 @@ struct Tables {
     cmf: Vec<Vec3>,
     /// D65 at 360 + 5 i nm.
     d65: Vec<f32>,
+    /// `XYZ_TO_LINEAR_SRGB · (x̄, ȳ, z̄) / ∫ȳ` at 360 + i nm ([`rgb_bar_table`]).
+    rgb_bar: Box<[[f32; 3]; CMF_SAMPLES]>,
 }
 
 fn tables() -> &'static Tables {
@@ -88,9 +90,16 @@ fn tables() -> &'static Tables {
             .expect("data/cie1931_2deg.csv is well formed (checked by the tests)");
         let d65 = parse(include_str!("data/d65.csv"), 1, D65_SAMPLES, D65_STEP)
             .expect("data/d65.csv is well formed (checked by the tests)");
+        let m = glam::DMat3::from_cols_array(&XYZ_TO_LINEAR_SRGB.to_cols_array().map(f64::from));
+        let rgb_bar = Box::new(std::array::from_fn(|i| {
+            let r = &cmf[i];
+            let xyz = glam::DVec3::new(r[0].into(), r[1].into(), r[2].into());
+            (m * xyz / f64::from(CIE_Y_INTEGRAL)).as_vec3().to_array()
+        }));
         Tables {
             cmf: cmf.iter().map(|r| Vec3::new(r[0], r[1], r[2])).collect(),
             d65: d65.iter().map(|r| r[0]).collect(),
+            rgb_bar,
         }
     })
 }
@@ -144,6 +153,15 @@ pub fn xyz_bar(lambda_nm: f32) -> Vec3 {
 /// The 1 nm table of the colour-matching functions: entry `i` is `(x̄, ȳ, z̄)` at `360 + i` nm.
 pub fn xyz_bar_table() -> &'static [Vec3] {
     &tables().cmf
+}
+
+/// The colour-matching functions in linear sRGB per unit `∫ȳ`: entry `i` is
+/// `XYZ_TO_LINEAR_SRGB · (x̄, ȳ, z̄)(360 + i nm) / CIE_Y_INTEGRAL` (computed in double precision), so
+/// that `Σ_λ f(λ) · rgb_bar(λ)` at 1 nm is [`xyz_to_linear_srgb`] of [`spectrum_to_xyz`]`(f)`.
+/// The spectral film's conversion reads it: one lookup per wavelength instead of the XYZ lookup
+/// and a matrix per path.
+pub fn rgb_bar_table() -> &'static [[f32; 3]; CMF_SAMPLES] {
+    &tables().rgb_bar
 }
 
 /// CIE standard illuminant D65, relative spectral power at `lambda_nm` (nm), normalised to 100 at
@@ -288,6 +306,23 @@ mod tests {
         );
         let w = d65_white_xyz();
         assert!((w.y - 1.0).abs() < 1e-6);
+    }
+
+    /// The pre-multiplied table sums to the same colour as XYZ through the matrix.
+    #[test]
+    fn rgb_bar_is_the_matrix_times_the_cmfs() {
+        let f = |l: f32| 0.2 + 0.6 * ((l - 360.0) / 470.0).powi(2);
+        let want = xyz_to_linear_srgb(spectrum_to_xyz(f));
+        let mut got = [0.0f64; 3];
+        for (i, bar) in rgb_bar_table().iter().enumerate() {
+            let v = f64::from(f(LAMBDA_MIN + i as f32));
+            for (g, b) in got.iter_mut().zip(bar) {
+                *g += v * f64::from(*b);
+            }
+        }
+        for (g, w) in got.iter().zip(want.to_array()) {
+            assert!((*g as f32 - w).abs() < 1e-5, "{got:?} vs {want}");
+        }
     }
 
     #[test]

@@ -12,8 +12,10 @@
 //! **To the film.** A path's estimate `L(λ_i)` at its wavelengths becomes CIE 1931 XYZ by
 //! `(1/4) Σ_i L(λ_i) (x̄, ȳ, z̄)(λ_i) / p(λ_i)`, divided by `∫ȳ` (so that a constant spectrum 1
 //! has `Y = 1`, as [`super::cie::spectrum_to_xyz`]), then linear Rec.709 through
-//! [`super::cie::xyz_to_linear_srgb`]; wavelengths whose density is 0 (terminated secondaries)
-//! add nothing, and the hero's density, divided by 4 at termination, makes it stand for the four.
+//! [`super::cie::xyz_to_linear_srgb`] — both linear, so computed in one step with the
+//! colour-matching functions already in linear Rec.709 ([`super::cie::rgb_bar_table`]);
+//! wavelengths whose density is 0 (terminated secondaries) add nothing, and the hero's density,
+//! divided by 4 at termination, makes it stand for the four.
 
 use super::wavelengths::{HeroWavelengths, N};
 use super::{Spectral, cie, rgb2spec};
@@ -131,7 +133,8 @@ thread_local! {
 #[inline]
 fn grey(c: Rgb) -> Option<f32> {
     let [r, g, b] = c.0;
-    (r == g && g == b && r >= 0.0 && r.is_finite()).then(|| r.min(f32::MAX / 4.0))
+    // Non-short-circuit `&`: the compares, one branch.
+    ((r == g) & (g == b) & (0.0..f32::INFINITY).contains(&r)).then(|| r.min(f32::MAX / 4.0))
 }
 
 /// `compute()` through the memo.
@@ -163,6 +166,28 @@ fn memo(
     v
 }
 
+/// A colour that is not grey at the wavelengths, through the memo: the conversions' slow path,
+/// kept out of line so that the grey fast paths inline into the integrator.
+#[inline(never)]
+fn coloured(kind: Kind, c: Rgb, lambda: &HeroWavelengths) -> HeroSample {
+    memo(kind, c, lambda, || match kind {
+        Kind::Reflectance => {
+            let s = rgb2spec::reflectance(c.0);
+            HeroSample::at(lambda, |l| s.eval(l))
+        }
+        Kind::Unbounded => {
+            let (scale, s) = rgb2spec::unbounded(c.0);
+            HeroSample::at(lambda, |l| scale * s.eval(l))
+        }
+        Kind::Illuminant => {
+            let (scale, s) = rgb2spec::illuminant(c.0);
+            HeroSample(std::array::from_fn(|i| {
+                scale * s.eval(lambda.lambda[i]) * lambda.illuminant[i]
+            }))
+        }
+    })
+}
+
 impl Spectral for HeroSample {
     type Wavelengths = HeroWavelengths;
     const WAVELENGTH_DIMENSIONS: u32 = 1;
@@ -180,38 +205,30 @@ impl Spectral for HeroSample {
         HeroWavelengths::sample(u)
     }
 
+    #[inline]
     fn from_reflectance(c: Rgb, lambda: &HeroWavelengths) -> Self {
         // A grey is exactly flat (the studio's floor, grey albedos): no lookup, no memo.
-        if let Some(v) = grey(c) {
-            return HeroSample::splat(v.min(1.0));
+        match grey(c) {
+            Some(v) => HeroSample::splat(v.min(1.0)),
+            None => coloured(Kind::Reflectance, c, lambda),
         }
-        memo(Kind::Reflectance, c, lambda, || {
-            let s = rgb2spec::reflectance(c.0);
-            HeroSample::at(lambda, |l| s.eval(l))
-        })
     }
 
+    #[inline]
     fn from_unbounded(c: Rgb, lambda: &HeroWavelengths) -> Self {
-        if let Some(v) = grey(c) {
-            return HeroSample::splat(v);
+        match grey(c) {
+            Some(v) => HeroSample::splat(v),
+            None => coloured(Kind::Unbounded, c, lambda),
         }
-        memo(Kind::Unbounded, c, lambda, || {
-            let (scale, s) = rgb2spec::unbounded(c.0);
-            HeroSample::at(lambda, |l| scale * s.eval(l))
-        })
     }
 
+    #[inline]
     fn from_illuminant(c: Rgb, lambda: &HeroWavelengths) -> Self {
         // A grey light or sky is D65 scaled (the studio's lights and sky gradient).
-        if let Some(v) = grey(c) {
-            return HeroSample(lambda.illuminant.map(|d| v * d));
+        match grey(c) {
+            Some(v) => HeroSample(lambda.illuminant.map(|d| v * d)),
+            None => coloured(Kind::Illuminant, c, lambda),
         }
-        memo(Kind::Illuminant, c, lambda, || {
-            let (scale, s) = rgb2spec::illuminant(c.0);
-            HeroSample(std::array::from_fn(|i| {
-                scale * s.eval(lambda.lambda[i]) * lambda.illuminant[i]
-            }))
-        })
     }
 
     fn from_measured(m: &super::measured::Measured, _rgb: Rgb, lambda: &HeroWavelengths) -> Self {
@@ -229,25 +246,25 @@ impl Spectral for HeroSample {
     }
 
     fn to_rgb(self, lambda: &HeroWavelengths) -> Rgb {
-        let mut xyz = [0.0f64; 3];
+        // `(1/4) Σ L(λ_i)/p(λ_i) · rgb_bar(λ_i)` with the colour-matching functions already in
+        // linear sRGB per unit `∫ȳ` (module docs), linear between their 1 nm values.
+        let bar = cie::rgb_bar_table();
+        let mut rgb = [0.0f32; 3];
         for i in 0..N {
             let p = lambda.pdf[i];
             if p > 0.0 {
-                let w = f64::from(self.0[i]) / f64::from(p);
-                let bar = cie::xyz_bar(lambda.lambda[i]).to_array();
-                for (x, b) in xyz.iter_mut().zip(bar) {
-                    *x += w * f64::from(b);
+                let w = self.0[i] / p;
+                let x = lambda.lambda[i] - cie::LAMBDA_MIN;
+                let j = super::wavelengths::index(x, cie::CMF_SAMPLES - 2);
+                let f = (x - j as f32).clamp(0.0, 1.0);
+                let (a, b) = (bar[j], bar[j + 1]);
+                for c in 0..3 {
+                    rgb[c] += w * (a[c] + f * (b[c] - a[c]));
                 }
             }
         }
-        let norm = N as f64 * f64::from(cie::CIE_Y_INTEGRAL);
-        let v = glam::Vec3::new(
-            (xyz[0] / norm) as f32,
-            (xyz[1] / norm) as f32,
-            (xyz[2] / norm) as f32,
-        );
-        let rgb = cie::xyz_to_linear_srgb(v);
-        Rgb::new(rgb.x, rgb.y, rgb.z)
+        let n = N as f32;
+        Rgb::new(rgb[0] / n, rgb[1] / n, rgb[2] / n)
     }
 
     #[inline]
@@ -277,7 +294,12 @@ impl Spectral for HeroSample {
 
     #[inline]
     fn is_valid(self) -> bool {
-        self.0.iter().all(|&c| c.is_finite() && c >= 0.0)
+        // "Every channel finite and ≥ 0", branch-free (it runs at every vertex): the smallest
+        // channel is ≥ 0 (`f32::min` skips NaN, and −0 passes as `−0 ≥ 0` does), and the sum in
+        // `f64` — which four `f32` cannot overflow — is finite exactly when every channel is.
+        let [a, b, c, d] = self.0;
+        let sum = f64::from(a) + f64::from(b) + f64::from(c) + f64::from(d);
+        (a.min(b).min(c.min(d)) >= 0.0) & (sum < f64::INFINITY)
     }
 
     #[inline]
@@ -331,6 +353,33 @@ mod tests {
         assert_eq!(a.average(), 2.5);
         assert!(!HeroSample([1.0, -0.0, 0.0, f32::NAN]).is_valid());
         assert!(HeroSample::ZERO.is_black());
+    }
+
+    /// The branch-free `is_valid` is "every channel finite and ≥ 0", on every combination of
+    /// the awkward values (8⁴ samples), and `grey` accepts exactly the finite non-negative greys.
+    #[test]
+    fn validity_is_finite_and_non_negative() {
+        let odd = [
+            0.0,
+            -0.0,
+            1.5,
+            -1e-30,
+            f32::MAX,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+        ];
+        for i in 0..odd.len().pow(4) {
+            let v: [f32; 4] =
+                std::array::from_fn(|k| odd[(i / odd.len().pow(k as u32)) % odd.len()]);
+            let want = v.iter().all(|&c| c.is_finite() && c >= 0.0);
+            assert_eq!(HeroSample(v).is_valid(), want, "{v:?}");
+        }
+        for &c in &odd {
+            let want = c.is_finite() && c >= 0.0;
+            assert_eq!(grey(Rgb::splat(c)).is_some(), want, "{c}");
+        }
+        assert_eq!(grey(Rgb::new(0.5, 0.5, 0.25)), None);
     }
 
     #[test]
