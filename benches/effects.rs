@@ -15,9 +15,11 @@
 //! `gems/tinted-glass-sphere.ron` for `platelets` (issue 18: every path segment inside the body
 //! passes the platelet code's test, forced on or off) and for `manifold-nee` (a smooth body
 //! where nothing inside scatters: no walk can start), and the rough-bodied `gems/milky-stone.ron`
-//! for `manifold-caustics` (the walk through the stone needs a smooth boundary). Each is 64 × 48 pixels, 16 spp, Sobol', max depth 8
+//! for `manifold-caustics` (the walk through the stone needs a smooth boundary), and the grey-lit
+//! `gems/lepidolite.ron` for `light-prefilter` (nothing to reduce). Each is 64 × 48 pixels, 16 spp, Sobol', max depth 8
 //! (`LAPIDARY_BENCH_SIZE=W` renders W × 3W/4), on one worker thread; the world is built outside
-//! the timed closure.
+//! the timed closure. `effects/light-prefilter-build` times the one place the prefilter runs:
+//! building the RGB day-glo world (`scenes/dayglo-laser-20.ron --spectral off`) with it on and off.
 //!
 //! Times are the **process's CPU time** on 64-bit Linux (all render threads), so other builds and
 //! tests on a small machine inflate them less than wall time; elsewhere wall time. Run with
@@ -29,6 +31,7 @@ use lapidary::recipe::GemRecipe;
 use lapidary::render::{Control, Film, World, render};
 use lapidary::scene::{Accuracy, Effect, Scene};
 use std::hint::black_box;
+use std::path::Path;
 use std::time::Duration;
 
 #[path = "common/clock.rs"]
@@ -134,7 +137,31 @@ fn scenes() -> Vec<(Effect, Scene)> {
         // No fluorescent base, in spectral transport (the dispersive diamond): the code is a
         // flag test per hit and the film wavelengths a copy per path.
         (Effect::Fluorescence, gem("brilliant-diamond.ron")),
+        // Grey studio lights and sky: the prefilter has nothing to reduce (its only code runs
+        // when the world is built).
+        (Effect::LightPrefilter, gem("lepidolite.ron")),
     ]
+}
+
+/// What the prefilter costs where it runs: building the RGB day-glo world (one material, the
+/// floor and the colorant's matrix reduced under the laser) with it on and off.
+fn prefilter_build(c: &mut Criterion<Clock>) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/dayglo-laser-20.ron");
+    let scene = GemRecipe::load(&path)
+        .and_then(|r| r.compile())
+        .expect("the day-glo scene compiles");
+    let rgb = forced(&scene, Effect::Spectral, false);
+    let mut group = c.benchmark_group("effects/light-prefilter-build");
+    group.sample_size(20);
+    for (name, s) in [
+        ("on", rgb.clone()),
+        ("off", forced(&rgb, Effect::LightPrefilter, false)),
+    ] {
+        group.bench_function(name, |b| {
+            b.iter(|| black_box(World::new(&s).expect("world builds")))
+        });
+    }
+    group.finish();
 }
 
 /// `scene` with `effect` forced `on`.
@@ -204,6 +231,6 @@ fn config() -> Criterion<Clock> {
 criterion::criterion_group! {
     name = benches;
     config = config();
-    targets = bench
+    targets = bench, prefilter_build
 }
 criterion::criterion_main!(benches);

@@ -190,7 +190,9 @@ pub(crate) fn stage(
                     .with_luminance(radiance.luminance())
             });
             // A line gives the light its colour and keeps its luminance.
-            let radiance = line.map_or(radiance, |l| l.to_rgb_emission());
+            let radiance = line.map_or(radiance, |l| {
+                keep_luminance(l.to_rgb_emission(), radiance.luminance())
+            });
             // A measured spectrum keeps the light's luminance and gives it its colour.
             let (radiance, spectrum) = match spectrum {
                 None => (radiance, None),
@@ -214,7 +216,10 @@ pub(crate) fn stage(
                         }
                         Ok(m) => {
                             let m = m.scaled(radiance.luminance() / m.luminance());
-                            (m.to_rgb_emission(), Some(m))
+                            (
+                                keep_luminance(m.to_rgb_emission(), radiance.luminance()),
+                                Some(m),
+                            )
                         }
                     }
                 }
@@ -328,6 +333,18 @@ pub(crate) fn stage(
     }
     stage_effects(&stage, effects);
     (errors.len() == n_errors).then_some(stage)
+}
+
+/// An emission colour clamped into the sRGB gamut ([`crate::spectrum::line::Line::to_rgb_emission`])
+/// scaled back to its spectrum's luminance `y`: clamping a 532 nm laser's negative red and blue
+/// raises its luminance by 19 %, which an RGB render would otherwise add to everything it lights.
+fn keep_luminance(rgb: Rgb, y: f32) -> Rgb {
+    let have = rgb.luminance();
+    if have > 0.0 && y.is_finite() {
+        rgb * (y / have)
+    } else {
+        rgb
+    }
 }
 
 /// Effects the stage calls for.

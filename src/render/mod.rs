@@ -25,6 +25,7 @@ pub mod memory;
 pub mod output;
 pub mod part;
 pub mod path;
+mod prefilter;
 pub mod setup;
 pub mod shading;
 pub mod study;

@@ -142,14 +142,37 @@ impl World {
         setup.check()?;
         let stone = Stone::new(&stage.shape, stage.to_world)?;
         setup.check()?;
+        let mut environment = EnvironmentLight::new(&stage.environment)?;
+        setup.check()?;
+        // An RGB render under lights with a spectrum: materials reduced under that light.
+        let prefilter = if scene.effects.on(Effect::LightPrefilter)
+            && !scene.effects.on(Effect::Spectral)
+        {
+            let (lo, hi) = stone.bounds();
+            let colorants = (scene.surface.stacks.iter().zip(&scene.surface.used))
+                .filter(|(_, used)| **used)
+                .filter_map(|(d, _)| d.fluorescence.as_deref());
+            super::prefilter::scene_light(&stage.lights, &environment, 0.5 * (lo + hi), colorants)
+        } else {
+            None
+        };
+        let prefiltered: Option<Vec<_>> = prefilter.as_ref().map(|p| {
+            scene
+                .surface
+                .stacks
+                .iter()
+                .map(|d| super::prefilter::stack(p, d))
+                .collect()
+        });
+        let stacks = prefiltered.as_deref().unwrap_or(&scene.surface.stacks);
         // Tables take tens of milliseconds per material: build them in parallel (the result is
         // the same in any order), at most one material per task, so a stop is noticed soon.
         // Materials whose stacks are identical share one build (the first of them builds).
         let mut seen: std::collections::HashMap<String, usize> = std::collections::HashMap::new();
-        let twin: Vec<usize> = (0..scene.surface.stacks.len())
+        let twin: Vec<usize> = (0..stacks.len())
             .map(|k| {
                 if scene.surface.used[k] {
-                    let key = format!("{:?}", scene.surface.stacks[k]);
+                    let key = format!("{:?}", stacks[k]);
                     *seen.entry(key).or_insert(k)
                 } else {
                     k
@@ -166,9 +189,7 @@ impl World {
         );
         let start = Instant::now();
         let shown = AtomicBool::new(false);
-        let built: Vec<Result<Option<(Bsdf, Rgb)>, WorldError>> = scene
-            .surface
-            .stacks
+        let built: Vec<Result<Option<(Bsdf, Rgb)>, WorldError>> = stacks
             .par_iter()
             .with_max_len(1)
             .enumerate()
@@ -227,6 +248,10 @@ impl World {
             // Platelet faces, under the body's IOR, from `body_index + 1`.
             for (name, desc) in &b.platelet_materials {
                 setup.check()?;
+                let desc = match &prefilter {
+                    Some(p) => &super::prefilter::stack(p, desc),
+                    None => desc,
+                };
                 let mut stack = LayeredBsdf::new(desc).map_err(|source| WorldError::Material {
                     name: format!("platelet:{name}"),
                     source,
@@ -285,7 +310,10 @@ impl World {
         // floor's light enters the base again (opaque stones keep the floor where it is).
         let (stone_lo, stone_hi) = stone.bounds();
         let size = (stone_hi - stone_lo).max_element().max(1e-6);
-        let ground = stage.ground.map(|g| {
+        let ground = stage.ground.map(|mut g| {
+            if let Some(p) = &prefilter {
+                g.albedo = super::prefilter::albedo(p, g.albedo, None);
+            }
             // Only where the map shows the body (forcing `transmission` on for a stone that
             // stays opaque must not move its floor).
             let resting = shows_body
@@ -303,8 +331,6 @@ impl World {
             )
         });
         let areas: Vec<Area> = stage.lights.iter().map(Area::new).collect();
-        setup.check()?;
-        let mut environment = EnvironmentLight::new(&stage.environment)?;
         setup.check()?;
         if !scene.effects.on(Effect::EnvironmentImportance) {
             environment.set_importance(false);

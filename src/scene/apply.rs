@@ -77,6 +77,22 @@ impl Scene {
             self.effects.force(e, on, by);
             self.accuracy.force(e, on);
         }
+        // A light's spectrum calls for spectral transport; rendered in RGB instead, it calls for
+        // the prefilter that reduces the materials under it.
+        self.effects.clear(Effect::LightPrefilter);
+        if !self.effects.on(Effect::Spectral) {
+            for (i, l) in self.stage.lights.iter().enumerate() {
+                let field = match (&l.line, &l.spectrum) {
+                    (Some(_), _) => "line",
+                    (None, Some(_)) => "spectrum",
+                    (None, None) => continue,
+                };
+                self.effects.turn_on(
+                    Effect::LightPrefilter,
+                    format!("stage.lights[{i}].{field} (RGB render: knobs from {by})"),
+                );
+            }
+        }
         self.accuracy.model = acc.model.or(self.accuracy.model);
         self.accuracy.fresnel = acc.fresnel.or(self.accuracy.fresnel);
         Ok(())

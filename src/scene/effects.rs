@@ -25,6 +25,10 @@ pub enum Effect {
     Spectral,
     /// Fluorescence, course §5.2.2 (issue 20): a used material whose Lambert base fluoresces.
     Fluorescence,
+    /// Spectral prefiltering (issue 20; Ward & Eydelberg-Vileshin 2002): an RGB render of a scene
+    /// whose lights have a line or a measured spectrum reduces its reflectances and fluorescent
+    /// colorants under that light instead of D65 ([`crate::spectrum::prefilter`]).
+    LightPrefilter,
     /// Thin-lens depth of field (a camera `aperture > 0`).
     DepthOfField,
     /// Importance sampling of an environment map.
@@ -43,7 +47,7 @@ pub enum Effect {
 
 impl Effect {
     /// Every effect, in a fixed order.
-    pub const ALL: [Effect; 14] = [
+    pub const ALL: [Effect; 15] = [
         Effect::Absorption,
         Effect::TTerm,
         Effect::FacetBump,
@@ -56,6 +60,7 @@ impl Effect {
         Effect::ManifoldCaustics,
         Effect::Spectral,
         Effect::Fluorescence,
+        Effect::LightPrefilter,
         Effect::DepthOfField,
         Effect::EnvironmentImportance,
     ];
@@ -77,6 +82,7 @@ impl Effect {
             Effect::Fluorescence => "fluorescence",
             Effect::DepthOfField => "depth-of-field",
             Effect::EnvironmentImportance => "environment-importance",
+            Effect::LightPrefilter => "light-prefilter",
         }
     }
 
@@ -108,6 +114,10 @@ impl Effect {
             Effect::Fluorescence => "a used material whose Lambert base has `fluorescence`",
             Effect::DepthOfField => "a perspective camera with aperture > 0",
             Effect::EnvironmentImportance => "an environment Map (EXR)",
+            Effect::LightPrefilter => {
+                "an RGB render (`--spectral off`) of a stage whose lights have a `line` or a \
+                 measured `spectrum`"
+            }
         }
     }
 

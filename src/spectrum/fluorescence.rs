@@ -257,6 +257,44 @@ impl Fluorescence {
         self.quantum_yield * self.excitation(lambda_i) * tail
     }
 
+    /// The light re-emitted under an incident spectrum given as quadrature nodes `(λi, L(λi)
+    /// dλi)` (nm, radiance per node, any order): `R(λo) = Σ_{λi ≤ λo} K(λi → λo) L(λi) dλi` at
+    /// `λo = 360, 361, …, 830` nm (the grid of [`cie::spectrum_to_xyz`]). A line's fine nodes
+    /// ([`Line::nodes`]) keep its exact position against the Stokes bound and `a`.
+    pub fn reemitted_spectrum(&self, nodes: &[(f32, f32)]) -> Vec<f32> {
+        let mut nodes = nodes.to_vec();
+        nodes.sort_by(|a, b| a.0.total_cmp(&b.0));
+        // `K` separates, `K = Q e(λo)/λo · a(λi) λi [λi ≤ λo]`: a running sum as `λo` rises.
+        let mut acc = 0.0f64;
+        let mut next = 0;
+        (0..CMF_SAMPLES)
+            .map(|i| {
+                let lo = LAMBDA_MIN + i as f32;
+                while next < nodes.len() && nodes[next].0 <= lo {
+                    let (l, w) = nodes[next];
+                    acc += f64::from(self.excitation(l)) * f64::from(l) * f64::from(w);
+                    next += 1;
+                }
+                (f64::from(self.quantum_yield * self.emission(lo) / lo) * acc) as f32
+            })
+            .collect()
+    }
+
+    /// CIE XYZ (normalised like [`cie::spectrum_to_xyz`]) of [`Fluorescence::reemitted_spectrum`].
+    pub fn reemitted_xyz(&self, nodes: &[(f32, f32)]) -> glam::Vec3 {
+        let out = self.reemitted_spectrum(nodes);
+        cie::spectrum_to_xyz(|l| out[((l - LAMBDA_MIN) as usize).min(CMF_SAMPLES - 1)])
+    }
+
+    /// The same colorant with the RGB matrix `matrix` in place of [`Fluorescence::rgb_matrix`]'s
+    /// (a matrix reduced under the scene's own light: [`super::prefilter`]).
+    pub fn with_rgb_matrix(&self, matrix: [[f32; 3]; 3]) -> Fluorescence {
+        Fluorescence {
+            matrix,
+            ..self.clone()
+        }
+    }
+
     /// The linear sRGB colour re-emitted under each unit primary's illuminant spectrum: column `k`
     /// for primary `k` (module docs). Multiply an incident RGB radiance by it for the RGB render.
     #[inline]

@@ -61,18 +61,35 @@ impl Line {
         }
     }
 
-    /// CIE XYZ of the line, normalised like [`cie::spectrum_to_xyz`] (`∫ L x̄ / ∫ ȳ` …), by the
-    /// midpoint rule over ±6σ in 2000 steps.
-    pub fn xyz(&self) -> Vec3 {
+    /// The midpoint rule's grid over ±6σ: its start, step and node count (2000); node `k` is at
+    /// `start + (k + ½) step`.
+    fn grid(&self) -> (f32, f32, usize) {
         let n = 2000;
         let (lo, hi) = (
             self.center - 6.0 * self.sigma,
             self.center + 6.0 * self.sigma,
         );
-        let h = (hi - lo) / n as f32;
-        let mut sum = Vec3::ZERO;
-        for k in 0..n {
+        (lo, (hi - lo) / n as f32, n)
+    }
+
+    /// The line as quadrature nodes `(λ, L(λ) dλ)` on [`Line::xyz`]'s grid (nm, radiance per
+    /// node). Integrals against smooth functions of λ (colour-matching functions, reflectances)
+    /// read it instead of a 1 nm grid, which a 1 nm wide line falls between.
+    pub fn nodes(&self) -> impl Iterator<Item = (f32, f32)> {
+        let line = *self;
+        let (lo, h, n) = self.grid();
+        (0..n).map(move |k| {
             let l = lo + (k as f32 + 0.5) * h;
+            (l, line.eval(l) * h)
+        })
+    }
+
+    /// CIE XYZ of the line, normalised like [`cie::spectrum_to_xyz`] (`∫ L x̄ / ∫ ȳ` …), by the
+    /// midpoint rule over ±6σ in 2000 steps.
+    pub fn xyz(&self) -> Vec3 {
+        let (_, h, _) = self.grid();
+        let mut sum = Vec3::ZERO;
+        for (l, _) in self.nodes() {
             sum += cie::xyz_bar(l) * self.eval(l);
         }
         sum * (h / CIE_Y_INTEGRAL)

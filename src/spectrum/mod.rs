@@ -29,6 +29,7 @@ pub mod fluorescence;
 pub mod hero;
 pub mod line;
 pub mod measured;
+pub mod prefilter;
 pub mod rgb;
 pub mod rgb2spec;
 pub mod wavelengths;

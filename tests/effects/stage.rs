@@ -1,5 +1,6 @@
 //! Effects of the stage — `depth-of-field`, `environment-importance` — and `fluorescence`, free
-//! where no base fluoresces (module docs of tests/effects.rs).
+//! where no base fluoresces, and `light-prefilter`, free where no light has a spectrum and in
+//! spectral transport (module docs of tests/effects.rs).
 
 use super::*;
 
@@ -122,6 +123,11 @@ fn fluorescence_code_changes_nothing_without_a_fluorescent_base() {
             stage: (camera: Perspective(from: (0.0, 2.6, 4.2), to: (0.0, 0.15, 0.0), fov: 30.0,
                                         aperture: 0.05)))"#,
     );
+    assert_untouched(
+        Effect::LightPrefilter,
+        "a scene calling for eight other effects",
+        &busy,
+    );
     let called: Vec<Effect> = busy.effects.iter().collect();
     assert_eq!(
         called.len(),
@@ -142,4 +148,35 @@ fn fluorescence_code_changes_nothing_without_a_fluorescent_base() {
         "the spectral brilliant diamond",
         &diamond,
     );
+}
+
+/// The day-glo card under the 532 nm laser at 20°, shrunk like the other scenes.
+fn dayglo() -> Scene {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/dayglo-laser-20.ron");
+    let mut s = GemRecipe::load(&path)
+        .and_then(|r| r.compile())
+        .unwrap_or_else(|e| panic!("{e}"));
+    small(&mut s);
+    s
+}
+
+#[test]
+fn light_prefilter_runs_only_for_rgb_renders_under_spectral_lights() {
+    // Spectral transport reads the spectra themselves: the laser scene (which calls for
+    // spectral) renders bit-identically with the prefilter forced either way.
+    let spectral = dayglo();
+    assert!(spectral.effects.on(Effect::Spectral));
+    assert_untouched(
+        Effect::LightPrefilter,
+        "the spectral day-glo laser scene",
+        &spectral,
+    );
+    // Rendered in RGB, the laser's line calls for it, and forcing it off changes the image
+    // (the card's green projected under D65 instead of reflected at 532 nm).
+    let rgb = forced(&spectral, Effect::Spectral, false);
+    assert_eq!(
+        rgb.effects.reason(Effect::LightPrefilter).map(|r| r.1),
+        Some(1)
+    );
+    assert_live(Effect::LightPrefilter, "the RGB day-glo laser scene", &rgb);
 }
