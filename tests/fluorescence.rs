@@ -350,3 +350,29 @@ fn the_measured_rhodamine_card_reradiates_green_as_yellow() {
     let green = [m[0][1], m[1][1], m[2][1]];
     assert!(green[0] > green[2] && green[1] > 0.0, "{green:?}");
 }
+
+/// A laser's RGB colour keeps the luminance the recipe gives it (`radiance × intensity`): the
+/// 532 nm line's linear Rec.709 colour has negative red and blue, and clamping them alone would
+/// make the RGB laser 19 % brighter than the spectral one.
+#[test]
+fn a_laser_keeps_its_luminance_in_rgb() {
+    let path = format!("{}/scenes/dayglo-laser-20.ron", env!("CARGO_MANIFEST_DIR"));
+    let scene = GemRecipe::load(std::path::Path::new(&path))
+        .and_then(|r| r.compile())
+        .unwrap_or_else(|e| panic!("{e}"));
+    let light = &scene.stage.lights[0];
+    let line = light.line.expect("the laser's line");
+    // Gray(50) × intensity 20000.
+    let want = 50.0 * 20000.0;
+    let y = light.radiance.luminance();
+    assert!(
+        (y / want - 1.0).abs() < 1e-4,
+        "RGB luminance {y}, want {want}"
+    );
+    assert!((line.xyz().y / want - 1.0).abs() < 1e-4);
+    let c = light.radiance.0;
+    assert!(c[0] == 0.0 && c[2] == 0.0 && c[1] > 0.0, "{c:?}");
+    // The clamped colour alone is brighter than the line.
+    let clamped = line.to_rgb_emission().luminance();
+    assert!(clamped > 1.15 * want, "{clamped} vs {want}");
+}
