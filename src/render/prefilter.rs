@@ -19,8 +19,8 @@
 
 use crate::bsdf::layered::{Base, StackDesc};
 use crate::color::Rgb;
-use crate::light::EnvironmentLight;
-use crate::scene::stage::{AreaLight, LightShape};
+use crate::light::{Area, EnvironmentLight};
+use crate::scene::stage::AreaLight;
 use crate::spectrum::fluorescence::Fluorescence;
 use crate::spectrum::prefilter::{Prefilter, Source};
 use crate::spectrum::rgb2spec;
@@ -53,27 +53,29 @@ pub(super) fn scene_light<'a>(
         sources.extend(Source::rgb(sky, sky.luminance() * 4.0 * PI));
     }
     let mut p = Prefilter::new(sources)?;
+    // Each distinct colorant once: materials sharing a dye re-emit one light, not several.
+    let mut seen: Vec<&Fluorescence> = vec![];
     for f in colorants {
-        p.add_reemission(f);
+        if !seen.contains(&f) {
+            p.add_reemission(f);
+            seen.push(f);
+        }
     }
     Some(p)
 }
 
-/// The solid angle the light subtends from `p`, sr: `A |cos θ_light| / d²`, at most 2π.
+/// The solid angle the light subtends from `p`, sr: `A |cos θ_light| / d²`, at most 2π (area
+/// and normal as the renderer's [`Area`] has them; 0 for a degenerate light).
 fn solid_angle(l: &AreaLight, p: Vec3) -> f32 {
-    let area = match l.shape {
-        LightShape::Rect { u, v } => 4.0 * u.length() * v.length(),
-        LightShape::Disc { radius } => PI * radius * radius,
-    };
+    let light = Area::new(l);
     let d = l.center - p;
     let d2 = d.length_squared();
-    let n = l.normal.try_normalize().unwrap_or(Vec3::Y);
     let cos = if d2 > 0.0 {
-        n.dot(d / d2.sqrt()).abs()
+        light.normal().dot(d / d2.sqrt()).abs()
     } else {
         1.0
     };
-    let omega = area * cos / d2;
+    let omega = light.area() * cos / d2;
     if omega.is_finite() {
         omega.min(2.0 * PI)
     } else {
@@ -136,6 +138,7 @@ pub(super) fn stack(p: &Prefilter, desc: &StackDesc) -> StackDesc {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::stage::LightShape;
     use crate::spectrum::line::Line;
 
     fn disc(center: Vec3, normal: Vec3, radius: f32) -> AreaLight {
