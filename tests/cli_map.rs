@@ -55,8 +55,15 @@ fn map_draws_the_shipped_gems_deterministically_on_any_thread_count() {
             "{gem}"
         );
         let img = image::open(&a).unwrap();
-        // The map plus the legend column.
-        assert_eq!(img.width(), 160 + 300, "{gem}");
+        // The map as asked, the legend beside it as tall as the map, and the summary says so.
+        assert_eq!(img.height(), 160, "{gem}");
+        assert!(img.width() > 160, "{gem}");
+        let first = report.lines().next().unwrap();
+        assert!(
+            first.contains("map 160×160 px")
+                && first.contains(&format!("({}×160 px)", img.width())),
+            "{first}"
+        );
         // Shares printed per material add up to 100 %.
         let total: f64 = report
             .lines()

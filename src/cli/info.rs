@@ -30,7 +30,11 @@ pub struct InfoArgs {
 
 /// Runs `lapidary info`.
 pub fn run(args: &InfoArgs) -> Result<()> {
-    let loaded = super::load::load_scene(&args.recipe, &args.knobs.accuracy(), None)?;
+    let loaded = super::load::load_scene(
+        &args.recipe,
+        &args.knobs.accuracy().map_err(anyhow::Error::msg)?,
+        None,
+    )?;
     out!("{}", describe(&loaded.recipe, &loaded.scene, args.points));
     Ok(())
 }

@@ -58,9 +58,11 @@ pub struct KnobArgs {
 
 impl KnobArgs {
     /// The knobs given, as the one knob type: the model and Fresnel mode, then the forced
-    /// effects (the aliases first, then every `--effect` in order; a later entry for an effect
-    /// replaces an earlier one).
-    pub fn accuracy(&self) -> Accuracy {
+    /// effects (the aliases first, then every `--effect` in order). An effect given twice with
+    /// the same value is one entry; given `on` and `off` (`--effect spectral=on --spectral off`,
+    /// `--bump on --effect facet-bump=off`, `--effect X=on --effect X=off`) it is refused, naming
+    /// both flags: the command line never resolves a contradiction silently.
+    pub fn accuracy(&self) -> Result<Accuracy, String> {
         let mut acc = Accuracy {
             model: self.model,
             fresnel: self.fresnel,
@@ -70,15 +72,33 @@ impl KnobArgs {
             calibration: self.calibration,
             effects: vec![],
         };
-        let aliases = [self.t_term, self.absorption, self.bump, self.spectral];
-        for (e, on) in aliases
+        let aliases = [
+            ("t-term", self.t_term),
+            ("absorption", self.absorption),
+            ("bump", self.bump),
+            ("spectral", self.spectral),
+        ];
+        let onoff = |on: bool| if on { "on" } else { "off" };
+        let given = aliases
             .into_iter()
-            .flatten()
-            .chain(self.effects.iter().copied())
-        {
+            .filter_map(|(flag, v)| v.map(|(e, on)| (format!("--{flag} {}", onoff(on)), e, on)))
+            .chain(
+                self.effects
+                    .iter()
+                    .map(|&(e, on)| (format!("--effect {}={}", e.name(), onoff(on)), e, on)),
+            );
+        let mut seen: Vec<(String, Effect, bool)> = vec![];
+        for (flag, e, on) in given {
+            if let Some((first, _, _)) = seen.iter().find(|(_, f, v)| *f == e && *v != on) {
+                return Err(format!(
+                    "`{flag}` contradicts `{first}`: the effect `{}` can be forced only one way",
+                    e.name()
+                ));
+            }
             acc.force(e, on);
+            seen.push((flag, e, on));
         }
-        acc
+        Ok(acc)
     }
 }
 
@@ -171,7 +191,7 @@ mod tests {
             ..KnobArgs::default()
         };
         assert_eq!(
-            k.accuracy().to_string(),
+            k.accuracy().unwrap().to_string(),
             "model=course,bump=off,depth-of-field=on"
         );
         assert!(effect_arg("sparkle=on").unwrap_err().contains("facet-bump"));
@@ -202,13 +222,58 @@ mod tests {
         ] {
             assert_eq!(parse(&alias), parse(&["--effect", effect]), "{alias:?}");
         }
-        // Both ways: `--effect` wins, whatever the order.
-        let both = parse(&["--effect", "facet-bump=on", "--bump", "off"]);
-        assert_eq!(both.forced(Effect::FacetBump), Some(true));
+        // Both ways with one value: one entry.
+        let both = parse(&["--effect", "facet-bump=off", "--bump", "off"]).unwrap();
+        assert_eq!(both.forced(Effect::FacetBump), Some(false));
         assert_eq!(both.effects.len(), 1);
-        let acc = parse(&["--model", "Reference", "--fresnel", "table"]);
+        let acc = parse(&["--model", "Reference", "--fresnel", "table"]).unwrap();
         assert_eq!(acc.to_string(), "model=reference,fresnel=table");
         assert!(Cli::try_parse_from(["lapidary", "--model", "fast"]).is_err());
+        assert!(
+            Cli::try_parse_from(["lapidary", "--model", "course", "--model", "course"]).is_err()
+        );
+    }
+
+    #[test]
+    fn contradictions_are_refused_naming_both_flags() {
+        use clap::Parser;
+        #[derive(Parser)]
+        struct Cli {
+            #[command(flatten)]
+            knobs: KnobArgs,
+        }
+        let parse = |args: &[&str]| {
+            let argv = std::iter::once("lapidary").chain(args.iter().copied());
+            Cli::try_parse_from(argv).unwrap().knobs.accuracy()
+        };
+        for (args, first, second) in [
+            (
+                &["--effect", "spectral=on", "--spectral", "off"][..],
+                "--spectral off",
+                "--effect spectral=on",
+            ),
+            (
+                &["--effect", "medium=on", "--effect", "medium=off"][..],
+                "--effect medium=on",
+                "--effect medium=off",
+            ),
+            (
+                &["--bump", "on", "--effect", "facet-bump=off"][..],
+                "--bump on",
+                "--effect facet-bump=off",
+            ),
+            (
+                &["--spectral", "--effect", "spectral=off"][..],
+                "--spectral on",
+                "spectral=off",
+            ),
+        ] {
+            let e = parse(args).unwrap_err();
+            assert!(e.contains(first) && e.contains(second), "{args:?}: {e}");
+        }
+        // The same value twice is not a contradiction.
+        let same = parse(&["--effect", "medium=off", "--effect", "medium=off"]).unwrap();
+        assert_eq!(same.effects.len(), 1);
     }
 
     #[test]

@@ -192,8 +192,8 @@ pub fn run(args: &MapArgs) -> Result<()> {
     } else {
         [20, 20, 20]
     };
-    let legend_w = if args.no_legend { 0 } else { 300 };
-    let (w, h) = (n + legend_w, n.max(40 + 22 * mats));
+    let legend = Legend::fitting(n, mats);
+    let (w, h) = (n + if args.no_legend { 0 } else { legend.width() }, n);
     let mut buf = vec![255u8; w * h * 3];
     let mut glitter = 0usize;
     for y in 0..n {
@@ -224,27 +224,25 @@ pub fn run(args: &MapArgs) -> Result<()> {
         }
     }
     if !args.no_legend {
-        draw_legend(&mut buf, (w, h), n, &names, &colours, &count)?;
+        draw_legend(&mut buf, (w, h), n, &legend, &names, &colours, &count)?;
     }
-    let img = image::RgbImage::from_raw(w as u32, h as u32, buf)
-        .ok_or_else(|| anyhow!("map: buffer size"))?;
-    super::write_atomically(&out_file, |tmp| {
-        img.save_with_format(tmp, image::ImageFormat::Png)
-            .map_err(|e| anyhow!("{}: {e}", args.out.display()))
-    })?;
+    crate::image::png::write_rgb8(&out_file, w as u32, h as u32, buf)?;
     // The summary: what share of the plane each material covers.
     let total = (n * n) as f64;
     let mut out = std::io::stdout().lock();
     writeln!(
         out,
-        "{}: {} materials, plane {:?}={}, extent ±{}, {}×{} px → {}",
+        "{}: {} materials, plane {:?}={}, extent ±{}, map {n}×{n} px{} → {} ({w}×{h} px)",
         loaded.recipe.file(),
         mats,
         ["x", "y", "z"][args.plane.axis],
         args.plane.offset,
         args.extent,
-        n,
-        n,
+        if args.no_legend {
+            String::new()
+        } else {
+            format!(" + legend {} px", w - n)
+        },
         args.out.display()
     )?;
     for (i, name) in names.iter().enumerate() {
@@ -258,11 +256,59 @@ pub fn run(args: &MapArgs) -> Result<()> {
     Ok(())
 }
 
-/// The legend column right of the map: a swatch, the name and the share of the plane per material.
+/// How the legend beside a map is laid out: as tall as the map, in as many columns of swatches
+/// as the materials need, the lines shrunk (to no less than [`Legend::MIN_LINE`]) before a column
+/// is added.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Legend {
+    /// Height of one entry, px.
+    line: usize,
+    /// Entries per column.
+    rows: usize,
+    /// Columns.
+    columns: usize,
+}
+
+impl Legend {
+    /// The line height of a roomy legend, px (a 15 px font).
+    const LINE: usize = 22;
+    /// The smallest line height, px.
+    const MIN_LINE: usize = 12;
+    /// A column's width at the roomy line height, px.
+    const COLUMN: usize = 300;
+    /// Margin above and below the entries, px.
+    const MARGIN: usize = 10;
+
+    /// The layout for `mats` entries beside a map `side` px tall.
+    fn fitting(side: usize, mats: usize) -> Legend {
+        let room = side.saturating_sub(2 * Self::MARGIN).max(Self::MIN_LINE);
+        let mats = mats.max(1);
+        let line = (room / mats).clamp(Self::MIN_LINE, Self::LINE);
+        let rows = (room / line).max(1);
+        Legend {
+            line,
+            rows,
+            columns: mats.div_ceil(rows),
+        }
+    }
+
+    /// Width of one column, px.
+    fn column(&self) -> usize {
+        Self::COLUMN * self.line / Self::LINE
+    }
+
+    /// Width of the whole legend, px.
+    fn width(&self) -> usize {
+        self.columns * self.column()
+    }
+}
+
+/// The legend right of the map: a swatch, the name and the share of the plane per material.
 fn draw_legend(
     buf: &mut [u8],
     (w, h): (usize, usize),
     left: usize,
+    layout: &Legend,
     names: &[String],
     colours: &[[u8; 3]],
     count: &[usize],
@@ -271,18 +317,20 @@ fn draw_legend(
     let total: usize = count.iter().sum::<usize>().max(1);
     let root = BitMapBackend::with_buffer(buf, (w as u32, h as u32)).into_drawing_area();
     let e = |e: DrawingAreaErrorKind<_>| anyhow!("legend: {e:?}");
-    let font = ("sans-serif", 15).into_font();
-    let x0 = left as i32 + 14;
+    let line = layout.line as i32;
+    let font = ("sans-serif", (line * 15 / 22) as u32).into_font();
+    let swatch = line * 16 / 22;
     for (i, name) in names.iter().enumerate() {
-        let y = 20 + 22 * i as i32;
+        let x0 = (left + 10 + (i / layout.rows) * layout.column()) as i32;
+        let y = (Legend::MARGIN + (i % layout.rows) * layout.line) as i32;
         let [r, g, b] = colours[i];
         root.draw(&Rectangle::new(
-            [(x0, y), (x0 + 16, y + 16)],
+            [(x0, y), (x0 + swatch, y + swatch)],
             RGBColor(r, g, b).filled(),
         ))
         .map_err(e)?;
         let label = format!("{name}  {:.1} %", 100.0 * count[i] as f64 / total as f64);
-        root.draw(&Text::new(label, (x0 + 24, y + 1), font.clone()))
+        root.draw(&Text::new(label, (x0 + swatch + 8, y + 1), font.clone()))
             .map_err(e)?;
     }
     root.present().map_err(e)?;
@@ -293,6 +341,28 @@ fn draw_legend(
 mod tests {
     use super::*;
     use crate::bsdf::ConductorIor;
+
+    #[test]
+    fn the_legend_is_as_tall_as_the_map() {
+        // Few materials: one roomy column.
+        assert_eq!(
+            Legend::fitting(768, 5),
+            Legend {
+                line: 22,
+                rows: 34,
+                columns: 1
+            }
+        );
+        // Lepidolite's 20 materials beside a 256 px map: the smallest lines, two columns.
+        let l = Legend::fitting(256, 20);
+        assert_eq!((l.line, l.columns), (12, 2));
+        assert!(l.rows * l.line <= 256 - 2 * Legend::MARGIN);
+        for (side, mats) in [(16, 1), (16, 300), (256, 20), (8192, 3)] {
+            let l = Legend::fitting(side, mats);
+            assert!(l.rows * l.columns >= mats, "{side} {mats}: {l:?}");
+            assert!(l.line >= Legend::MIN_LINE && l.line <= Legend::LINE);
+        }
+    }
 
     #[test]
     fn planes_parse_and_reject_nonsense() {

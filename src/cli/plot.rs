@@ -210,9 +210,5 @@ pub fn plot_stack(
 /// Encodes a plot's RGB8 buffer (`w × h`) as a PNG at `path`, written atomically: plotters draws
 /// into the buffer, the `image` crate (PNG only) encodes it.
 pub fn save_png(buf: Vec<u8>, w: u32, h: u32, path: &Path) -> Result<()> {
-    let img = image::RgbImage::from_raw(w, h, buf).ok_or_else(|| anyhow!("plot: buffer size"))?;
-    super::write_atomically(path, |tmp| {
-        img.save_with_format(tmp, image::ImageFormat::Png)
-            .map_err(|e| anyhow!("{}: {e}", path.display()))
-    })
+    Ok(crate::image::png::write_rgb8(path, w, h, buf)?)
 }

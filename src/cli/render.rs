@@ -245,6 +245,7 @@ pub fn run(args: &RenderArgs) -> Result<bool> {
     // Installed first, so that a signal during setup also stops cleanly. The flag is never
     // reset: a signal that arrives right after the handler is installed must not be lost.
     let cancel = interrupted();
+    let started = Instant::now();
     let (exr_path, png_path) = outputs(args)?;
     let mut plan = OutputPlan::new();
     plan.input(&args.recipe, "the recipe")?;
@@ -253,7 +254,11 @@ pub fn run(args: &RenderArgs) -> Result<bool> {
         Some(p) => Some(plan.output(p, Format::Png)?),
         None => None,
     };
-    let loaded = super::load::load_scene(&args.recipe, &args.knobs.accuracy(), Some(&mut plan))?;
+    let loaded = super::load::load_scene(
+        &args.recipe,
+        &args.knobs.accuracy().map_err(anyhow::Error::msg)?,
+        Some(&mut plan),
+    )?;
     let mut scene = loaded.scene;
     settings(args, &mut scene);
     // A range past the render's samples is refused before any setup.
@@ -290,6 +295,7 @@ pub fn run(args: &RenderArgs) -> Result<bool> {
         }
         Err(e) => return Err(e.into()),
     };
+    let setup_time = started.elapsed();
     for w in world.environment.warnings() {
         eprintln!("warning: {}: {w}", args.recipe.display());
     }
@@ -377,6 +383,7 @@ pub fn run(args: &RenderArgs) -> Result<bool> {
                 args,
                 &scene,
                 &rendered,
+                setup_time,
                 &exr_path,
                 png_path.as_deref(),
                 was_interrupted
@@ -399,11 +406,13 @@ fn grouped(n: u64) -> String {
     out
 }
 
-/// The closing summary.
+/// The closing summary. The time is split into setup (reading the recipe, building the material
+/// tables, maps and lights: `setup`) and rendering (the samples: the rates are per second of it).
 fn summary(
     args: &RenderArgs,
     scene: &Scene,
     r: &Rendered,
+    setup: Duration,
     exr: &Path,
     png: Option<&Path>,
     interrupted: bool,
@@ -411,14 +420,17 @@ fn summary(
     let s = &r.stats;
     let set = &scene.stage.render;
     let secs = s.elapsed.as_secs_f64().max(1e-9);
+    let setup = setup.as_secs_f64();
     let mut out = format!(
-        "rendered {}: {}x{}, {} spp ({}), depth {} in {:.1} s\n",
+        "rendered {}: {}x{}, {} spp ({}), depth {} in {:.1} s: setup {:.1} s, rendering {:.1} s\n",
         args.recipe.display(),
         set.width,
         set.height,
         set.spp,
         set.sampler.name(),
         set.max_depth,
+        setup + secs,
+        setup,
         secs
     );
     if let Some(range) = &args.samples {

@@ -145,8 +145,12 @@ pub fn run(args: &TradeoffArgs) -> Result<()> {
     let mut plan = OutputPlan::new();
     plan.input(&args.recipe, "the recipe")?;
     plan.folder(&args.out)?;
-    let mut base =
-        super::load::load_scene(&args.recipe, &args.knobs.accuracy(), Some(&mut plan))?.scene;
+    let mut base = super::load::load_scene(
+        &args.recipe,
+        &args.knobs.accuracy().map_err(anyhow::Error::msg)?,
+        Some(&mut plan),
+    )?
+    .scene;
     let (w, h) = args.size;
     base.stage.render.width = w;
     base.stage.render.height = h;

@@ -7,6 +7,7 @@ use glam::Vec3;
 use obvhs::{BvhBuildParams, aabb::Aabb, bvh2::Bvh2, bvh2::builder::build_bvh2, ray::RayHit};
 use std::path::Path;
 
+mod closed;
 mod obj;
 
 /// A triangle mesh in object space (object units): triangles stored in BVH order with their unit
@@ -204,26 +205,6 @@ impl Mesh {
     /// Number of triangles kept.
     pub fn triangle_count(&self) -> usize {
         self.tris.len()
-    }
-
-    /// Directed edges without their reverse: 0 for a closed mesh whose triangles are wound
-    /// consistently (each edge shared by exactly two triangles that traverse it in opposite
-    /// directions). Vertices are matched by their exact coordinates, as an OBJ file's shared
-    /// vertices are. A translucent body needs 0: its inside and outside come from the winding.
-    pub fn open_edges(&self) -> usize {
-        use std::collections::HashMap;
-        let key = |v: Vec3| [v.x.to_bits(), v.y.to_bits(), v.z.to_bits()];
-        let mut count: HashMap<([u32; 3], [u32; 3]), i32> = HashMap::new();
-        for t in &self.tris {
-            for k in 0..3 {
-                let (a, b) = (key(t[k]), key(t[(k + 1) % 3]));
-                *count.entry((a, b)).or_insert(0) += 1;
-            }
-        }
-        count
-            .iter()
-            .filter(|&(&(a, b), &n)| n != 1 || count.get(&(b, a)) != Some(&1))
-            .count()
     }
 
     /// Number of degenerate (zero-area) triangles skipped at load.
@@ -487,25 +468,5 @@ mod tests {
                 }
             }
         }
-    }
-
-    /// A tetrahedron wound outward is closed; one flipped or missing face is reported.
-    #[test]
-    fn open_edges_finds_holes_and_flips() {
-        let v = [
-            Vec3::new(0.0, 0.0, 0.0),
-            Vec3::new(1.0, 0.0, 0.0),
-            Vec3::new(0.0, 1.0, 0.0),
-            Vec3::new(0.0, 0.0, 1.0),
-        ];
-        let faces = [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]];
-        let tris: Vec<[Vec3; 3]> = faces.iter().map(|f| f.map(|i| v[i])).collect();
-        let closed = Mesh::from_triangles(tris.clone(), None).unwrap();
-        assert_eq!(closed.open_edges(), 0);
-        let mut flipped = tris.clone();
-        flipped[3].swap(1, 2);
-        assert_eq!(Mesh::from_triangles(flipped, None).unwrap().open_edges(), 3);
-        let holed = Mesh::from_triangles(tris[..3].to_vec(), None).unwrap();
-        assert_eq!(holed.open_edges(), 3);
     }
 }

@@ -2,19 +2,30 @@
 //! rename it over the target. Readers see either the old file or the complete new one, and a
 //! failed (or panicking) write leaves the old file untouched and no temporary file behind.
 //!
+//! Every byte goes through a [`Sink`], which keeps the first I/O error of any write, flush or
+//! seek — even one an encoder ignored — and `fsync`s the file before it may be renamed: on a full
+//! disk, a quota or an I/O error (`ENOSPC`, `EDQUOT`, `EIO`) nothing is renamed, and the command
+//! fails naming the file and the error.
+//!
 //! Several files can be replaced all or nothing ([`all_or_nothing`]): every temporary file is
 //! written first, and only when all of them are complete are they renamed, one after the other,
 //! under a lock that [`abort_process`] (the second Ctrl-C) also takes — so an abort sees either no
-//! rename or all of them.
+//! rename or all of them. The renames also hold an advisory lock on each target directory
+//! ([`lock`]), so two lapidary processes replacing the same files never interleave: the set on
+//! disk is always one run's.
 //!
 //! Temporary files are named `.NAME.lapidary-PID-N.tmp.EXT`. One left behind by a process that
 //! was killed outright (SIGKILL, power loss) is recognised by that name: the first write of a
 //! later run into the same directory removes every such file whose process no longer exists
 //! (checked as `/proc/PID`; where there is no `/proc`, leftovers are kept).
 
+mod lock;
+mod sink;
+
+pub use self::sink::Sink;
+use self::lock::DirLocks;
 use std::cell::RefCell;
 use std::collections::HashSet;
-use std::fs::OpenOptions;
 use std::io;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -23,15 +34,16 @@ use std::sync::{Mutex, MutexGuard};
 /// The marker between a target's name and the process id in a temporary file's name.
 const MARKER: &str = ".lapidary-";
 
-/// Writes a file atomically: `write` fills a temporary file beside `path` (same extension, so
-/// encoders that look at it still work), which then replaces `path` by a rename. A failure leaves
-/// an existing `path` untouched. Inside [`all_or_nothing`] the rename waits for the others.
+/// Writes a file atomically: `write` fills a [`Sink`] on a temporary file beside `path` (same
+/// extension), which then replaces `path` by a rename. A failure — of `write`, of any I/O call
+/// it made, of the final flush and `fsync` — leaves an existing `path` untouched. Inside
+/// [`all_or_nothing`] the rename waits for the others.
 pub fn write_atomically(
     path: &Path,
-    write: impl FnOnce(&Path) -> anyhow::Result<()>,
+    write: impl FnOnce(&mut Sink) -> anyhow::Result<()>,
 ) -> anyhow::Result<()> {
-    replace_with(path, write, |p, e| {
-        anyhow::anyhow!("{}: cannot replace: {e}", p.display())
+    replace_with(path, write, |p, what, e| {
+        anyhow::Error::new(crate::image::ImageError::io(p, what, e))
     })
 }
 
@@ -51,6 +63,7 @@ pub fn all_or_nothing<T>(write: impl FnOnce() -> anyhow::Result<T>) -> anyhow::R
     let value = write()?;
     let pending = BATCH.with(|b| b.borrow_mut().take()).unwrap_or_default();
     std::mem::forget(guard);
+    let dirs = DirLocks::of(pending.iter().map(|(_, t)| t.as_path()));
     let live = live();
     let mut done: Vec<&Path> = vec![];
     let mut failure = None;
@@ -66,6 +79,7 @@ pub fn all_or_nothing<T>(write: impl FnOnce() -> anyhow::Result<T>) -> anyhow::R
         }
     }
     forget_live(live, pending.iter().map(|(t, _)| t.as_path()));
+    drop(dirs);
     match failure {
         None => Ok(value),
         Some((target, e)) => {
@@ -95,28 +109,31 @@ pub fn abort_process(code: i32) -> ! {
     std::process::exit(code)
 }
 
-/// The generic form of [`write_atomically`]: `io_error` turns a file-system failure of the
-/// replacement itself (not of `write`) into the caller's error type.
+/// The generic form of [`write_atomically`]: `io_error(path, what, e)` turns a file-system
+/// failure (of the temporary file's creation or writing, `what` = "write", or of the rename,
+/// `what` = "replace") into the caller's error type.
 pub(crate) fn replace_with<E>(
     path: &Path,
-    write: impl FnOnce(&Path) -> Result<(), E>,
-    io_error: impl FnOnce(&Path, io::Error) -> E,
+    write: impl FnOnce(&mut Sink) -> Result<(), E>,
+    io_error: impl Fn(&Path, &str, io::Error) -> E,
 ) -> Result<(), E> {
     let tmp = match temp_path(path) {
         Ok(t) => t,
-        Err(e) => return Err(io_error(path, e)),
+        Err(e) => return Err(io_error(path, "write", e)),
     };
     live().push(tmp.clone());
     let guard = RemoveOnDrop(&tmp);
-    write(&tmp)?;
-    // Flush the data before the rename so a crash cannot leave a renamed but empty file.
-    let synced = OpenOptions::new()
-        .write(true)
-        .open(&tmp)
-        .and_then(|f| f.sync_all());
-    if let Err(e) = synced {
-        return Err(io_error(path, e));
+    let mut sink = match Sink::create(&tmp) {
+        Ok(s) => s,
+        Err(e) => return Err(io_error(path, "write", e)),
+    };
+    let written = write(&mut sink);
+    // An I/O error the encoder saw is the cause even when it reported something vaguer.
+    let finished = sink.finish();
+    if let Err(e) = finished {
+        return Err(io_error(path, "write", e));
     }
+    written?;
     let deferred = BATCH.with(|b| match b.borrow_mut().as_mut() {
         Some(pending) => {
             pending.push((tmp.clone(), path.to_path_buf()));
@@ -128,18 +145,20 @@ pub(crate) fn replace_with<E>(
         std::mem::forget(guard);
         return Ok(());
     }
+    let dirs = DirLocks::of([path]);
     let mut live = live();
     let renamed = std::fs::rename(&tmp, path);
     if renamed.is_ok() {
         live.retain(|p| p != &tmp);
     }
     drop(live);
+    drop(dirs);
     match renamed {
         Ok(()) => {
             std::mem::forget(guard);
             Ok(())
         }
-        Err(e) => Err(io_error(path, e)),
+        Err(e) => Err(io_error(path, "replace", e)),
     }
 }
 
@@ -266,6 +285,7 @@ impl Drop for BatchGuard {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::io::Write;
 
     fn scratch(name: &str) -> PathBuf {
         let dir = std::env::temp_dir().join(format!("lapidary-atomic-{}", std::process::id()));
@@ -286,8 +306,8 @@ mod tests {
     fn failed_write_keeps_old_file() {
         let path = scratch("keep.txt");
         std::fs::write(&path, "old").unwrap();
-        let err = write_atomically(&path, |tmp| {
-            std::fs::write(tmp, "partial")?;
+        let err = write_atomically(&path, |sink| {
+            sink.write_all(b"partial")?;
             anyhow::bail!("encoder failed")
         })
         .unwrap_err();
@@ -301,8 +321,8 @@ mod tests {
         let path = scratch("panic.txt");
         std::fs::write(&path, "old").unwrap();
         let r = std::panic::catch_unwind(|| {
-            write_atomically(&path, |tmp| {
-                std::fs::write(tmp, "partial").unwrap();
+            write_atomically(&path, |sink| {
+                sink.write_all(b"partial").unwrap();
                 panic!("boom")
             })
         });
@@ -315,14 +335,15 @@ mod tests {
     fn success_replaces_and_keeps_extension() {
         let path = scratch("new.png");
         std::fs::write(&path, "old").unwrap();
-        write_atomically(&path, |tmp| {
+        write_atomically(&path, |sink| {
+            let tmp = sink.path().to_path_buf();
             assert_eq!(tmp.extension().unwrap(), "png");
             assert_eq!(tmp.parent(), path.parent());
             assert_eq!(
                 temp_owner(&tmp.file_name().unwrap().to_string_lossy()),
                 Some(std::process::id())
             );
-            Ok(std::fs::write(tmp, "new")?)
+            Ok(sink.write_all(b"new")?)
         })
         .unwrap();
         assert_eq!(std::fs::read_to_string(&path).unwrap(), "new");
@@ -335,13 +356,12 @@ mod tests {
     }
 
     #[test]
-    fn nothing_written_is_an_error() {
-        let path = scratch("never.txt");
-        let _ = std::fs::remove_file(&path);
-        let err = write_atomically(&path, |_| Ok(())).unwrap_err();
-        assert!(err.to_string().contains("never.txt"), "{err}");
-        assert!(!path.exists());
-        assert!(write_atomically(Path::new("/"), |_| Ok(())).is_err());
+    fn a_path_that_is_no_file_is_an_error() {
+        let err = write_atomically(Path::new("/"), |_| Ok(())).unwrap_err();
+        assert!(err.to_string().starts_with("/: cannot write"), "{err}");
+        let missing = scratch("no/such/dir/x.txt");
+        let err = write_atomically(&missing, |_| Ok(())).unwrap_err();
+        assert!(err.to_string().contains("x.txt: cannot write"), "{err}");
     }
 
     #[test]
@@ -351,7 +371,7 @@ mod tests {
         std::fs::write(&b, "old b").unwrap();
         // The second write fails: the first, already complete, must not be renamed.
         let err = all_or_nothing(|| {
-            write_atomically(&a, |t| Ok(std::fs::write(t, "new a")?))?;
+            write_atomically(&a, |s| Ok(s.write_all(b"new a")?))?;
             assert_eq!(
                 std::fs::read_to_string(&a).unwrap(),
                 "old a",
@@ -367,7 +387,7 @@ mod tests {
         // A panic inside the batch: the same.
         let r = std::panic::catch_unwind(|| {
             all_or_nothing::<()>(|| {
-                write_atomically(&a, |t| Ok(std::fs::write(t, "new a")?))?;
+                write_atomically(&a, |s| Ok(s.write_all(b"new a")?))?;
                 panic!("boom")
             })
         });
@@ -376,13 +396,45 @@ mod tests {
         assert!(leftovers(&a).is_empty());
         // Both succeed: both replaced.
         all_or_nothing(|| {
-            write_atomically(&a, |t| Ok(std::fs::write(t, "new a")?))?;
-            write_atomically(&b, |t| Ok(std::fs::write(t, "new b")?))
+            write_atomically(&a, |s| Ok(s.write_all(b"new a")?))?;
+            write_atomically(&b, |s| Ok(s.write_all(b"new b")?))
         })
         .unwrap();
         assert_eq!(std::fs::read_to_string(&a).unwrap(), "new a");
         assert_eq!(std::fs::read_to_string(&b).unwrap(), "new b");
         assert!(leftovers(&a).is_empty() && leftovers(&b).is_empty());
+    }
+
+    #[test]
+    fn an_io_error_an_encoder_ignores_still_keeps_every_old_file() {
+        let (exr, png) = (scratch("io-a.exr"), scratch("io-b.png"));
+        std::fs::write(&exr, "old exr").unwrap();
+        std::fs::write(&png, "old png").unwrap();
+        let pixels = vec![0x5au8; 3 * 64 * 64];
+        for (errno, code) in [("ENOSPC", 28), ("EIO", 5), ("EDQUOT", 122)] {
+            for at in ["0", "100", "sync"] {
+                sink::TEST_FAULT.with(|f| *f.borrow_mut() = Some(format!("{errno}@{at}:png")));
+                let err = all_or_nothing(|| {
+                    write_atomically(&exr, |s| Ok(s.write_all(b"new exr")?))?;
+                    // The PNG encoder's own errors are dropped here on purpose.
+                    Ok(crate::image::png::write_rgb8(&png, 64, 64, pixels.clone())?)
+                })
+                .unwrap_err();
+                sink::TEST_FAULT.with(|f| *f.borrow_mut() = None);
+                let io = err
+                    .chain()
+                    .find_map(|c| c.downcast_ref::<crate::image::ImageError>())
+                    .map(|e| e.to_string())
+                    .unwrap_or_default();
+                assert!(
+                    io.contains("io-b.png") && io.contains(&format!("os error {code}")),
+                    "{errno}@{at}: {err:#}"
+                );
+                assert_eq!(std::fs::read_to_string(&exr).unwrap(), "old exr");
+                assert_eq!(std::fs::read_to_string(&png).unwrap(), "old png");
+                assert!(leftovers(&exr).is_empty() && leftovers(&png).is_empty());
+            }
+        }
     }
 
     #[test]

@@ -148,11 +148,15 @@ pub fn write_exr_raw(path: &Path, img: &ExrImage, raw: &[RawChannel]) -> Result<
         Encoding::SMALL_LOSSLESS,
         AnyChannels::sort(list),
     );
-    let write = |tmp: &Path| Image::from_layer(layer).write().to_file(tmp);
     super::atomic::replace_with(
         path,
-        |tmp| write(tmp).map_err(|e| ImageError::write(path, e)),
-        ImageError::write,
+        |sink| {
+            Image::from_layer(layer)
+                .write()
+                .to_buffered(sink)
+                .map_err(|e| ImageError::write(path, e))
+        },
+        ImageError::io,
     )
 }
 

@@ -173,6 +173,19 @@ pub enum ImageError {
 }
 
 impl ImageError {
+    /// A [`ImageError::Write`] for a file-system failure of an atomic write (see
+    /// [`atomic::replace_with`]): `what` is "write" or "replace".
+    pub(crate) fn io(path: &std::path::Path, what: &str, e: std::io::Error) -> Self {
+        let reason = match what {
+            "write" => format!("{e}; the old file, if any, is unchanged"),
+            _ => format!("cannot {what} it: {e}"),
+        };
+        ImageError::Write {
+            path: path.into(),
+            reason,
+        }
+    }
+
     /// A [`ImageError::Write`] about `path`.
     pub(crate) fn write(path: &std::path::Path, reason: impl std::fmt::Display) -> Self {
         ImageError::Write {

@@ -153,6 +153,21 @@ impl OutputPlan {
 }
 
 fn inaccessible(path: &Path, e: &io::Error) -> OutputError {
+    // "Not a directory" alone does not say which part of the path is the file in the way.
+    if e.kind() == io::ErrorKind::NotADirectory
+        && let Some((dir, meta)) = path
+            .ancestors()
+            .skip(1)
+            .filter(|a| !a.as_os_str().is_empty())
+            .find_map(|a| std::fs::metadata(a).ok().map(|m| (a, m)))
+        && !meta.is_dir()
+    {
+        return OutputError::NoDirectory {
+            path: path.into(),
+            dir: dir.into(),
+            why: "is not a directory (a file is in the way)",
+        };
+    }
     OutputError::Inaccessible {
         path: path.into(),
         reason: e.to_string(),

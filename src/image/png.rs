@@ -102,17 +102,33 @@ pub fn write_png(
     write_rgb8(path, width, height, bytes)
 }
 
-/// Writes 8-bit RGB bytes (row-major, top row first) as a PNG, atomically.
+/// Writes 8-bit RGB bytes (row-major, top row first) as a PNG, atomically (every write checked:
+/// see [`super::atomic`]).
 pub fn write_rgb8(path: &Path, width: u32, height: u32, bytes: Vec<u8>) -> Result<(), ImageError> {
-    let img = ::image::RgbImage::from_raw(width, height, bytes)
-        .ok_or_else(|| ImageError::write(path, "pixel buffer size"))?;
+    if bytes.len() as u64 != 3 * u64::from(width) * u64::from(height) || width == 0 || height == 0
+    {
+        return Err(ImageError::write(path, "pixel buffer size"));
+    }
     super::atomic::replace_with(
         path,
-        |tmp| {
-            img.save_with_format(tmp, ::image::ImageFormat::Png)
-                .map_err(|e| ImageError::write(path, e))
-        },
-        ImageError::write,
+        |sink| encode_rgb8(sink, width, height, &bytes).map_err(|e| ImageError::write(path, e)),
+        ImageError::io,
+    )
+}
+
+/// Encodes 8-bit RGB bytes as a PNG into `out`.
+pub fn encode_rgb8(
+    out: &mut impl std::io::Write,
+    width: u32,
+    height: u32,
+    bytes: &[u8],
+) -> ::image::ImageResult<()> {
+    use ::image::ImageEncoder;
+    ::image::codecs::png::PngEncoder::new(out).write_image(
+        bytes,
+        width,
+        height,
+        ::image::ExtendedColorType::Rgb8,
     )
 }
 

@@ -32,6 +32,12 @@ pub enum WorldError {
          closed mesh whose triangles are all wound counter-clockwise seen from outside"
     )]
     OpenBody(usize),
+    /// A translucent body on a closed mesh wound inside-out (or enclosing no volume): its normals
+    /// would point into the stone.
+    #[error(
+        "the stone's mesh is closed but wound inside-out (signed volume {0:.4e} object units³): a          translucent body needs its triangles wound counter-clockwise seen from outside (flip          every face, e.g. reverse each `f` line's vertex order in the OBJ)"
+    )]
+    InsideOutBody(f64),
     /// A walk of the body's explicit platelets could not cover the stone (its diagonal spans more
     /// cells of a population than a walk visits).
     #[error(transparent)]

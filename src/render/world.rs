@@ -282,6 +282,10 @@ impl World {
             if open > 0 {
                 return Err(WorldError::OpenBody(open));
             }
+            let volume = m.signed_volume();
+            if volume <= 0.0 {
+                return Err(WorldError::InsideOutBody(volume));
+            }
         }
         let interior = match body {
             Some(b) if shows_body => {

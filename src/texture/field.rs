@@ -129,11 +129,17 @@ impl FieldTable {
         &self.nodes
     }
 
-    /// Value of field `id` at object-space point `p`; always finite (a node whose value would
-    /// overflow or be undefined, e.g. marble at |p| ≈ 1e38, reads 0).
+    /// Value of field `id` at object-space point `p`; always finite. A node whose value overflows
+    /// saturates (+∞ reads `f32::MAX`, −∞ reads `−f32::MAX`), so a switch on a huge field still
+    /// takes its last stop; one whose value is undefined (NaN, e.g. marble at |p| ≈ 1e38 or
+    /// ∞ − ∞ in a sum) reads 0.
     pub fn eval(&self, id: FieldId, p: Vec3) -> f32 {
         let v = self.eval_raw(id, p);
-        if v.is_finite() { v } else { 0.0 }
+        if v.is_nan() {
+            0.0
+        } else {
+            v.clamp(-f32::MAX, f32::MAX)
+        }
     }
 
     /// A conservative interval `(lo, hi)` holding every value [`FieldTable::eval`] can return for
@@ -290,6 +296,31 @@ mod tests {
                 clamp: false
             })
             .is_err()
+        );
+    }
+
+    #[test]
+    fn overflow_saturates_so_a_switch_takes_its_last_stop() {
+        use crate::texture::map::{Stop, choose_stop};
+        let mut t = FieldTable::default();
+        let big = t.add(FieldNode::Constant(1e30)).unwrap();
+        let (first, count) = t.add_args(&[big, big]);
+        let up = t.add(FieldNode::Product { first, count }).unwrap();
+        let neg = t.add(FieldNode::Constant(-1e30)).unwrap();
+        let (first, count) = t.add_args(&[neg, big]);
+        let down = t.add(FieldNode::Product { first, count }).unwrap();
+        let (first, count) = t.add_args(&[up, down]);
+        let undefined = t.add(FieldNode::Sum { first, count }).unwrap();
+        assert_eq!(t.eval(up, Vec3::ZERO), f32::MAX);
+        assert_eq!(t.eval(down, Vec3::ZERO), -f32::MAX);
+        // MAX + (−MAX) is 0 here; a true ∞ − ∞ inside one node is NaN and reads 0 too.
+        assert_eq!(t.eval(undefined, Vec3::ZERO), 0.0);
+        let stops = [0.0, 0.5, 0.9].map(|threshold| Stop { threshold, node: 0 });
+        let mut u = 0.5;
+        assert_eq!(choose_stop(&stops, t.eval(up, Vec3::ZERO), 0.0, &mut u), 2);
+        assert_eq!(
+            choose_stop(&stops, t.eval(down, Vec3::ZERO), 0.0, &mut u),
+            0
         );
     }
 

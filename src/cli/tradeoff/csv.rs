@@ -59,7 +59,9 @@ pub(super) fn curves_csv(rows: &[Row]) -> String {
 }
 
 pub(super) fn write_csv(path: &Path, text: &str) -> Result<()> {
-    crate::image::write_atomically(path, |tmp| {
-        std::fs::write(tmp, text).with_context(|| format!("writing {}", path.display()))
+    crate::image::write_atomically(path, |sink| {
+        use std::io::Write as _;
+        sink.write_all(text.as_bytes())
+            .with_context(|| format!("writing {}", path.display()))
     })
 }
