@@ -65,6 +65,16 @@ MI_BSDFS = {
                       "diffuse_reflectance": {"type": "rgb", "value": [0.5, 0.5, 0.5]}},
     "smooth-plastic": {"type": "plastic", "int_ior": 1.5, "ext_ior": 1.0, "nonlinear": True,
                        "diffuse_reflectance": {"type": "rgb", "value": [0.5, 0.5, 0.5]}},
+    # Translucent bodies: a sphere of glass (Mitsuba's `roughdielectric` has no multiple-scattering
+    # compensation and uses the separable Smith masking, hence lapidary's `compensation: false`,
+    # `masking: SmithSeparable`), with an absorbing interior where "interior" is given (σa per
+    # unit; rendered with `volpath`).
+    "glass-rough": {"type": "roughdielectric", "distribution": "ggx", "alpha": 0.3,
+                    "int_ior": 1.5, "ext_ior": 1.0},
+    "glass-absorbing": {"type": "dielectric", "int_ior": 1.5, "ext_ior": 1.0,
+                        "interior": [0.2, 0.5, 1.0]},
+    "glass-rough-absorbing": {"type": "roughdielectric", "distribution": "ggx", "alpha": 0.3,
+                              "int_ior": 1.5, "ext_ior": 1.0, "interior": [0.2, 0.5, 1.0]},
 }
 
 # Lapidary materials (scripts/parity/materials.ron) and the Mitsuba BSDF each is compared with.
@@ -79,6 +89,10 @@ CASES = (
     ("rough-plastic-reference-nocomp", "rough-plastic"),
     ("smooth-plastic", "smooth-plastic"),
     ("smooth-plastic-reference", "smooth-plastic"),
+    ("glass-rough-nocomp", "glass-rough"),
+    ("glass-rough", "glass-rough"),
+    ("glass-absorbing", "glass-absorbing"),
+    ("glass-rough-absorbing-nocomp", "glass-rough-absorbing"),
 )
 
 
@@ -113,11 +127,16 @@ def parse_args():
 
 def mi_scene(mi, lighting, bsdf, size):
     T = mi.ScalarTransform4f
+    desc = dict(MI_BSDFS[bsdf])
+    interior = desc.pop("interior", None)
+    glass = "dielectric" in desc["type"]
     scene = {
         "type": "scene",
         # Lapidary's default depth is 8 scattering events; Mitsuba counts the camera segment too.
-        # On a convex sphere every path scatters once, so depth only has to be ≥ 2.
-        "integrator": {"type": "path", "max_depth": 9},
+        # On a convex sphere every path scatters once, so depth only has to be ≥ 2. Light
+        # crosses a glass sphere many times: 64 events in lapidary (the recipes' max_depth).
+        "integrator": {"type": "volpath" if interior else "path",
+                       "max_depth": 65 if glass else 9},
         "sensor": {
             "type": "perspective", "fov": 30.0, "fov_axis": "y",
             "to_world": T().look_at(origin=[0, 0, 4], target=[0, 0, 0], up=[0, 1, 0]),
@@ -125,9 +144,12 @@ def mi_scene(mi, lighting, bsdf, size):
                      "rfilter": {"type": "box"}},  # Mitsuba's box: radius 0.5 px, one pixel
             "sampler": {"type": "independent"},
         },
-        "sphere": {"type": "sphere", "center": [0, 0, 0], "radius": 1.0,
-                   "bsdf": MI_BSDFS[bsdf]},
+        "sphere": {"type": "sphere", "center": [0, 0, 0], "radius": 1.0, "bsdf": desc},
     }
+    if interior:
+        scene["sphere"]["interior"] = {
+            "type": "homogeneous", "albedo": 0.0,
+            "sigma_t": {"type": "rgb", "value": interior}}
     if lighting == "sky":
         scene["sky"] = {"type": "constant", "radiance": {"type": "rgb", "value": [1.0] * 3}}
     else:

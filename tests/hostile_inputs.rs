@@ -155,3 +155,38 @@ fn the_summary_gives_setup_and_rendering_apart() {
     let (total, setup, rendering) = (num(" in "), num("setup "), num("rendering "));
     assert!((total - setup - rendering).abs() <= 0.1 + 1e-9, "{first}");
 }
+
+#[test]
+fn a_file_where_a_folder_goes_is_named_as_one() {
+    let s = Scratch::new("hostile", "folders");
+    std::fs::write(
+        s.path("gem.ron"),
+        GLASS.replace("Mesh(file: \"cube.obj\")", "Sphere(radius: 1.0)"),
+    )
+    .unwrap();
+    std::fs::create_dir(s.path("f")).unwrap();
+    std::fs::write(s.path("f/parts"), "x").unwrap();
+    let out = lapidary(
+        &s,
+        &[
+            "farm", "slurm", "gem.ron", "--parts", "2", "--spp", "4", "--dir", "f",
+        ],
+    );
+    let err = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("f/parts: is a regular file; an output folder must be a directory"),
+        "the message names the file in the way and what it should be:\n{err}"
+    );
+    std::fs::write(s.path("t"), "x").unwrap();
+    let out = lapidary(
+        &s,
+        &["tradeoff", "gem.ron", "--out", "t/sub", "--budget", "0.1"],
+    );
+    let err = text(&out.stderr);
+    assert!(
+        err.contains("directory t is not a directory (a file is in the way)"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read_to_string(s.path("f/parts")).unwrap(), "x");
+}

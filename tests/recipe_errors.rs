@@ -1,11 +1,15 @@
 //! A table of malformed gem recipes: each must be rejected by `GemRecipe::check_source` with its
 //! first error at the expected `file:line:col` and a message naming what is wrong (and, for numbers,
-//! the allowed range). Also: several errors in one file, and the
-//! `lapidary check` command line.
+//! the allowed range). Also: several errors in one file (and, in `every_error`, every error of a
+//! file in one check, each where it is when alone, none twice), and the `lapidary check` command
+//! line.
 
 use lapidary::recipe::{GemRecipe, RecipeError, Source};
 use std::path::{Path, PathBuf};
 use std::process::Command;
+
+#[path = "recipe_errors/every_error.rs"]
+mod every_error;
 
 /// One malformed recipe and what its first error must say.
 struct Row {
@@ -116,8 +120,8 @@ fn rows() -> Vec<Row> {
         row("ior_nan", (3, 40), &["coats[1].ior = NaN", "1.0001 ..= 10"], coat("ior: NaN, roughness: 1.0")),
         row("roughness_zero", (3, 50), &["coats[1].roughness = 0 ", "0.01 ..< 90"], coat("ior: 1.5, roughness: 0.0")),
         row("roughness_ninety", (3, 50), &["coats[1].roughness = 90", "0.01 ..< 90"], coat("ior: 1.5, roughness: 90.0")),
-        row("thickness_negative", (3, 66), &["coats[1].thickness = -1", "0 ..= finite"], coat("ior: 1.5, roughness: 1.0, thickness: -1.0")),
-        row("absorption_negative", (3, 82), &["coats[1].absorption[0] = -1", ">= 0"], coat("ior: 1.5, roughness: 1.0, thickness: 1.0, absorption: Rgb(-1.0, 0.0, 0.0)")),
+        row("thickness_negative", (3, 66), &["coats[1].thickness = -1", "any finite value ≥ 0"], coat("ior: 1.5, roughness: 1.0, thickness: -1.0")),
+        row("absorption_negative", (3, 82), &["coats[1].absorption[0] = -1", "any finite value ≥ 0"], coat("ior: 1.5, roughness: 1.0, thickness: 1.0, absorption: Rgb(-1.0, 0.0, 0.0)")),
         row("tint_no_thickness", (3, 66), &["coats[1].tint needs thickness > 0"], coat("ior: 1.5, roughness: 1.0, tint: Gray(0.5)")),
         row("absorption_and_tint", (3, 39), &["coats[1]", "either `absorption` or `tint`, not both"], coat("ior: 1.5, roughness: 1.0, thickness: 1.0, absorption: Gray(0.1), tint: Gray(0.5)")),
         row("albedo_nan", (3, 17), &["base.albedo", "must be finite"], s("(materials: {\n \"c\": (coats: [(ior: 1.5, roughness: 1.0)],\n  base: Lambert(albedo: Rgb(0.5, NaN, 0.5))),\n},\n surface: Material(\"c\"))")),
@@ -197,6 +201,12 @@ fn rows() -> Vec<Row> {
         row("platelets_modulation_remap_below_zero", (5, 16), &["body.platelets[1]", "modulation", "-1 ..= 0", "never above 0"], platelets("(density: 3000.0, radius: (0.01, 0.03), orientation: Uniform, entries: [(1.0, \"a\")],\n   modulation: Remap(field: Perlin(scale: 0.3), from: (-1.0, 1.0), to: (-1.0, 0.0), clamp: true))")),
         row("platelets_stone_too_large", (4, 3), &["body.platelets[1]: the stone spans 205", "platelet cells along its diagonal, at most 65533", "allowed 1 ..= 65533", "a smaller stone"], gem(" body: (ior: 1.5, platelets: [\n  (density: 3000.0, radius: (0.01, 0.03), orientation: Uniform, entries: [(1.0, \"a\")]),\n  (density: 10000000.0, radius: (0.001, 0.002), orientation: Uniform, entries: [(1.0, \"a\")])]),\n surface: Body,\n stage: (shape: Sphere(radius: 200.0)),\n")),
         row("platelets_under_ior_3_5", (3, 20), &["body.platelets[0]", "material \"b\" under the body", "outside_ior = 3.5", "1 ..= 3"], gem(" body: (ior: 3.5, platelets: [(density: 3000.0, radius: (0.01, 0.03), orientation: Uniform,\n   entries: [(1.0, \"b\"), (1.0, \"a\")])]),\n surface: Body")),
+        // Readable ranges: no bound printed as the largest float or integer.
+        row("blend_one_stop", (2, 75), &["blend = -1", "allowed any finite value ≥ 0"], gem(" surface: Switch(by: Constant(0.0), stops: [(0.0, Material(\"a\"))], blend: -1.0)")),
+        row("seed_negative", (2, 8), &["seed = -1", "allowed 0 ..= 2⁶⁴ − 1 (a whole number)"], gem(" seed: -1,\n surface: Material(\"a\")")),
+        // A Sellmeier law below its resonance (C₁ = 0.25 µm²: 500 nm) gives n² < 1: the law's own
+        // n², not the index 1 it is clamped to.
+        row("sellmeier_n2_below_one", (3, 3), &["body.dispersion", "n² = 0.4618 < 1 (n = 0.6796) at 360 nm", "allowed 1 <.. 4"], gem(" body: (ior: 1.6771,\n  dispersion: Sellmeier(b: (0.5, 0.0, 0.0), c: (0.25, 0.0, 0.0))),\n surface: Body")),
         row("light_target_is_center", (6, 4), &["stage.lights[1]", "`target` equals `center`"], stage("  lights: [\n   Rect(center: (0.0, 4.0, 0.0), size: (1.0, 1.0), radiance: Gray(1.0)),\n   Disc(center: (1.0, 2.0, 3.0), target: (1.0, 2.0, 3.0), radius: 1.0, radiance: Gray(1.0)),\n  ],")),
     ];
     rows
@@ -288,7 +298,7 @@ fn one_check_reports_every_error() {
             &[
                 "material \"bad_coat\"",
                 "coats[0].thickness = -2",
-                "0 ..= finite",
+                "any finite value ≥ 0",
             ],
         ),
         (

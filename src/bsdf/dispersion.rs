@@ -78,25 +78,48 @@ impl Ior {
     }
 
     /// The index at `lambda_nm` (nm). A Sellmeier law evaluated at a resonance or where `n² < 1`
-    /// gives 1 (no refraction) rather than a non-finite index.
+    /// gives 1 (no refraction) rather than a non-finite index; so does any law below 1.
     pub fn at(&self, lambda_nm: f32) -> f32 {
-        let l = f64::from(lambda_nm) * 1e-3;
-        let l2 = l * l;
         let n = match *self {
-            Ior::Constant(n) => f64::from(n),
-            Ior::Cauchy { a, b, c } => f64::from(a) + f64::from(b) / l2 + f64::from(c) / (l2 * l2),
-            Ior::Sellmeier { b, c } => {
-                let n2 = 1.0
-                    + (0..3)
-                        .map(|i| f64::from(b[i]) * l2 / (l2 - f64::from(c[i])))
-                        .sum::<f64>();
+            Ior::Sellmeier { .. } => {
+                let n2 = self.n_squared(lambda_nm);
                 if n2 >= 1.0 { n2.sqrt() } else { 1.0 }
             }
+            _ => self.unclamped(lambda_nm),
         };
         if n.is_finite() && n >= 1.0 {
             n as f32
         } else {
             1.0
+        }
+    }
+
+    /// `n²` at `lambda_nm` (nm) as the law gives it, without [`Ior::at`]'s clamping: for a
+    /// Sellmeier law `1 + Σ Bᵢ λ²/(λ² − Cᵢ)` itself, which is below 1 (even below 0: no real
+    /// index) short of a resonance and not finite at one (`λ² = Cᵢ`); for the others the square
+    /// of their index.
+    pub fn n_squared(&self, lambda_nm: f32) -> f64 {
+        match *self {
+            Ior::Sellmeier { b, c } => {
+                let l = f64::from(lambda_nm) * 1e-3;
+                let l2 = l * l;
+                1.0 + (0..3)
+                    .map(|i| f64::from(b[i]) * l2 / (l2 - f64::from(c[i])))
+                    .sum::<f64>()
+            }
+            _ => self.unclamped(lambda_nm).powi(2),
+        }
+    }
+
+    /// The index of a constant or Cauchy law at `lambda_nm`, unclamped (a Sellmeier law: the
+    /// root of its `n²`, NaN below 0).
+    fn unclamped(&self, lambda_nm: f32) -> f64 {
+        let l = f64::from(lambda_nm) * 1e-3;
+        let l2 = l * l;
+        match *self {
+            Ior::Constant(n) => f64::from(n),
+            Ior::Cauchy { a, b, c } => f64::from(a) + f64::from(b) / l2 + f64::from(c) / (l2 * l2),
+            Ior::Sellmeier { .. } => self.n_squared(lambda_nm).sqrt(),
         }
     }
 
@@ -176,5 +199,29 @@ mod tests {
             let n = resonant.at(l);
             assert!(n.is_finite() && n >= 1.0, "{l}: {n}");
         }
+    }
+
+    #[test]
+    fn n_squared_is_the_law_itself_where_the_index_is_clamped() {
+        // BK7 at the d line: the square of its index.
+        let n = f64::from(BK7.at(LAMBDA_D));
+        assert!((BK7.n_squared(LAMBDA_D) - n * n).abs() < 1e-5);
+        // B = 1, C = 0.25 µm² at 400 nm: 1 + 0.16/(0.16 − 0.25) = −7/9, below 0; at the
+        // resonance (500 nm) not finite; at 360 nm with B = 0.5: 1 − 0.0648/0.1204 ≈ 0.462.
+        let resonant = |b: f32| Ior::Sellmeier {
+            b: [b, 0.0, 0.0],
+            c: [0.25, 0.0, 0.0],
+        };
+        assert!((resonant(1.0).n_squared(400.0) + 7.0 / 9.0).abs() < 1e-6);
+        assert!(!resonant(1.0).n_squared(500.0).is_finite());
+        let n2 = resonant(0.5).n_squared(360.0);
+        assert!((n2 - (1.0 - 0.5 * 0.1296 / 0.1204)).abs() < 1e-6, "{n2}");
+        assert_eq!(resonant(0.5).at(360.0), 1.0);
+        let cauchy = Ior::Cauchy {
+            a: 0.5,
+            b: 0.1,
+            c: 0.0,
+        };
+        assert!((cauchy.n_squared(1000.0) - 0.36).abs() < 1e-6);
     }
 }

@@ -22,7 +22,8 @@
 //!   Jakob–Hanika basis spectra): the stack's tables (energy, calibration, multiple-reflection
 //!   lobe) are built per RGB channel, so the spectrum of a coated stack is a spectrum of its RGB
 //!   value, not the stack of its parameters' spectra (docs/spectral.md states what this costs in
-//!   colour).
+//!   colour) — except that a measured diffuse base under clear coats is read per wavelength
+//!   through the stack's albedo ladder ([`measured_base`]).
 
 use super::dispersion::Dispersion;
 use super::layered::Model;
@@ -100,10 +101,11 @@ impl Scatter<HeroSample> for Bsdf {
                 (Some(Bsdf::Lambert(l)), Some(m)) => lambert(l, Some(m), wo, wi, lambda),
                 (Some(Bsdf::OrenNayar(o)), Some(m)) => oren_nayar(o, Some(m), wo, wi, lambda),
                 (Some(base), _) => base.eval_at(wo, wi, mode, lambda),
-                (None, _) => fluorescent_elastic(
+                (None, _) => measured_base(
                     b,
                     wo,
                     wi,
+                    mode,
                     upsample(b.eval_mode(wo, wi, mode), lambda),
                     lambda,
                 ),
@@ -149,7 +151,7 @@ impl Scatter<HeroSample> for Bsdf {
                 Some(base) => base.sample_at(wo, uc, u, mode, lambda),
                 None => {
                     let s = b.sample_mode(wo, uc, u, mode)?;
-                    let f = fluorescent_elastic(b, wo, s.wi, upsample(s.f, lambda), lambda);
+                    let f = measured_base(b, wo, s.wi, mode, upsample(s.f, lambda), lambda);
                     // `weight = f |cos θi| / pdf` (BsdfSample::from_eval), except for the
                     // Reference walk's unbiased weight.
                     let weight = if s.pdf_is_proportional {
@@ -204,23 +206,34 @@ impl Scatter<HeroSample> for Bsdf {
     }
 }
 
-/// The elastic reflection of a coated fluorescent base (issue 20) with its measured reflectance
-/// per wavelength: the stack's upsampled RGB value `f` with its single-scatter base term
-/// `D(wo, wi) · ρ` ([`super::layered::fluorescent`]: the Corrected model's body for a Lambert base
-/// of albedo `ρ`) moved from the upsampled RGB albedo to `ρ(λ)`. The dye absorbs most of the
-/// laser's green: its elastic `ρ(532 nm)` is 0.09 where the upsampled projection gives several
-/// times more. The multiple-reflection lobe and the albedo calibration keep their RGB values.
-/// Any other stack: `f` unchanged.
+/// The value at the wavelengths of a coated stack whose diffuse base has a measured reflectance.
+/// - With an albedo ladder (coats that do not absorb, [`super::layered::ladder`]): the stack
+///   with a grey base of the measured albedo `ρ(λ)` at each wavelength, to the ladder's
+///   interpolation.
+/// - A fluorescent base's elastic reflection: the stack's upsampled RGB value `f` with its
+///   single-scatter base term `D(wo, wi) · ρ` ([`super::LayeredBsdf::fluorescent_value`]: the
+///   Corrected model's body for a Lambert base of albedo `ρ` under clear coats) moved from the
+///   upsampled RGB albedo to `ρ(λ)` — the dye absorbs most of a laser's green: its elastic
+///   `ρ(532 nm)` is 0.09 where the upsampled projection gives several times more; the
+///   multiple-reflection lobe and the albedo calibration keep their RGB values.
+///
+/// Any other stack: `f` unchanged (the spectrum of its RGB value).
 #[inline]
-fn fluorescent_elastic(
+fn measured_base(
     b: &super::LayeredBsdf,
     wo: Vec3,
     wi: Vec3,
+    mode: TransportMode,
     f: HeroSample,
     lambda: &HeroWavelengths,
 ) -> HeroSample {
-    let (Some(m), Some(_), Bsdf::Lambert(base)) = (b.base_spectrum, b.fluorescence(), &b.base)
-    else {
+    let Some(m) = b.base_spectrum else {
+        return f;
+    };
+    if let Some(ladder) = &b.ladder {
+        return HeroSample(ladder.eval(wo, wi, mode, lambda.lambda.map(|l| m.at(l))));
+    }
+    let (Some(_), Bsdf::Lambert(base)) = (b.fluorescence(), &b.base) else {
         return f;
     };
     let d = b.fluorescent_value(wo, wi);

@@ -1,7 +1,8 @@
 //! `lapidary check FILE…`: checks gem recipes and material libraries completely — syntax, includes,
 //! every material, the whole map tree, the stage — and prints every error found as
 //! `file:line:col: message`, warnings likewise, and one summary line per file. Exits non-zero when
-//! any file has an error.
+//! any file has an error. A number out of range does not hide what follows it (the parser records
+//! it and goes on, [`crate::recipe::source::recover`]); a syntax error still ends the file's check.
 
 use crate::recipe::{GemRecipe, MaterialLibrary, RecipeError, Source};
 use clap::Args;

@@ -2,7 +2,10 @@
 //! into the render of their whole sample range. The parts must share the recipe hash, seed,
 //! size, spp, sampler, depth, knobs and strategy, and their ranges must be disjoint and cover
 //! `0..spp`; every problem is listed (files that disagree, ranges missing or overlapping) and
-//! nothing is written. The sums are exact integers ([`crate::render::fixed`]), so the EXR equals
+//! nothing is written. Nothing a part says is believed that can be checked ([`Part::read`]): a
+//! part is refused by its file type before it is opened (a FIFO would block), and its attributes
+//! must lie in the ranges `lapidary render` accepts and agree with its per-pixel sums (every
+//! pixel holds exactly the samples of the part's range, kept or dropped). The sums are exact integers ([`crate::render::fixed`]), so the EXR equals
 //! a one-machine render bit for bit (all channels; `lapidary.render_time` is the parts' sum).
 
 use crate::image::atomic::all_or_nothing;

@@ -22,8 +22,8 @@
 mod lock;
 mod sink;
 
-pub use self::sink::Sink;
 use self::lock::DirLocks;
+pub use self::sink::Sink;
 use std::cell::RefCell;
 use std::collections::HashSet;
 use std::io;

@@ -105,8 +105,7 @@ pub fn write_png(
 /// Writes 8-bit RGB bytes (row-major, top row first) as a PNG, atomically (every write checked:
 /// see [`super::atomic`]).
 pub fn write_rgb8(path: &Path, width: u32, height: u32, bytes: Vec<u8>) -> Result<(), ImageError> {
-    if bytes.len() as u64 != 3 * u64::from(width) * u64::from(height) || width == 0 || height == 0
-    {
+    if bytes.len() as u64 != 3 * u64::from(width) * u64::from(height) || width == 0 || height == 0 {
         return Err(ImageError::write(path, "pixel buffer size"));
     }
     super::atomic::replace_with(

@@ -23,9 +23,11 @@
 //! uniform `transform.scale` is applied at compile time, so a scaled stone keeps its look.
 
 use super::color::ColorDesc;
+pub use super::dispersion::DispersionDesc;
 use super::platelets::PlateletsDesc;
+use super::ranged::refuse;
 use super::spectrum::SpectrumDesc;
-use crate::bsdf::dispersion::{Ior, LAMBDA_D};
+use crate::bsdf::dispersion::Ior;
 use crate::bsdf::{Distribution, Masking};
 use crate::color::Rgb;
 use crate::medium::phase::G_LIMIT;
@@ -50,9 +52,14 @@ fn sigma<'de, D: Deserializer<'de>>(d: D, what: &str) -> Result<(f32, f32, f32),
     {
         Ok(v)
     } else {
-        Err(serde::de::Error::custom(format!(
-            "medium.{what} = {v:?}: each coefficient must be 0 ..= {SIGMA_MAX} per object unit"
-        )))
+        // Stand-in: each coefficient at its nearest allowed value (NaN: 0).
+        let f = |c: f32| if c > SIGMA_MAX { SIGMA_MAX } else { c.max(0.0) };
+        refuse(
+            format!(
+                "medium.{what} = {v:?}: each coefficient must be 0 ..= {SIGMA_MAX} per object unit"
+            ),
+            (f(v.0), f(v.1), f(v.2)),
+        )
     }
 }
 
@@ -71,21 +78,33 @@ pub const MIN_TRANSMITTANCE: f32 = 1e-6;
 
 fn transmittance<'de, D: Deserializer<'de>>(d: D) -> Result<Option<ColorDesc>, D::Error> {
     let c = ColorDesc::deserialize(d)?;
+    // The stand-in for a refused colour.
+    let grey = || Some(ColorDesc::Gray(0.5));
     if let Some(m) = c.measured(1.0) {
         // A measured colour: its values within 0 ..= 1 (checked here), read per wavelength.
-        return m.map(|_| Some(c)).map_err(|e| {
-            serde::de::Error::custom(format!("medium.colour: {e}: the share of light left"))
-        });
+        return match m {
+            Ok(_) => Ok(Some(c)),
+            Err(e) => refuse(
+                format!("medium.colour: {e}: the share of light left"),
+                grey(),
+            ),
+        };
     }
-    let rgb = c.to_rgb().map_err(serde::de::Error::custom)?;
+    let rgb = match c.to_rgb() {
+        Ok(rgb) => rgb,
+        Err(e) => return refuse(e, grey()),
+    };
     if rgb.0.iter().all(|&v| v > 0.0 && v <= 1.0) {
         Ok(Some(c))
     } else {
-        Err(serde::de::Error::custom(format!(
-            "medium.colour = {c:?} is linear {:?}: each channel must be 0 <.. 1 (the share of white light \
-             left after `distance`)",
-            rgb.0
-        )))
+        refuse(
+            format!(
+                "medium.colour = {c:?} is linear {:?}: each channel must be 0 <.. 1 (the share of \
+                 white light left after `distance`)",
+                rgb.0
+            ),
+            grey(),
+        )
     }
 }
 
@@ -98,9 +117,12 @@ fn opt_angle<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f32>, D::Error> {
     if v == 0.0 || (0.01..90.0).contains(&v) {
         Ok(Some(v))
     } else {
-        Err(serde::de::Error::custom(format!(
-            "body.roughness = {v} is out of range: allowed 0 (smooth) or 0.01 ..< 90 degrees"
-        )))
+        refuse(
+            format!(
+                "body.roughness = {v} is out of range: allowed 0 (smooth) or 0.01 ..< 90 degrees"
+            ),
+            Some(0.0),
+        )
     }
 }
 
@@ -110,15 +132,20 @@ fn opt_alpha<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f32>, D::Error> {
     if v == 0.0 || (lo..=hi).contains(&v) {
         Ok(Some(v))
     } else {
-        Err(serde::de::Error::custom(format!(
-            "body.alpha = {v} is out of range: allowed 0 (smooth) or {lo} ..= {hi}"
-        )))
+        refuse(
+            format!("body.alpha = {v} is out of range: allowed 0 (smooth) or {lo} ..= {hi}"),
+            Some(0.0),
+        )
     }
 }
 
 fn default_distribution() -> Distribution {
     Distribution::Ggx
 }
+fn default_compensation() -> bool {
+    true
+}
+
 fn default_masking() -> Masking {
     Masking::Smith
 }
@@ -143,6 +170,13 @@ pub struct BodyDesc {
     /// Masking of a rough boundary (default Smith, Walter et al. 2007).
     #[serde(default = "default_masking")]
     pub masking: Masking,
+    /// Whether a rough boundary returns the energy single scattering loses (the reciprocal
+    /// multiple-scattering lobe of `bsdf::interface_energy`; default `true`, so a clear body in
+    /// a white furnace is exactly 1). `false` is the plain Walter et al. (2007) interface, as
+    /// Mitsuba 3's `roughdielectric`, pbrt-v4's and Cycles' are: it loses energy at every rough
+    /// event (a furnace reads below 1), and is there to match them.
+    #[serde(default = "default_compensation")]
+    pub compensation: bool,
     /// How the IOR changes with the wavelength; `None`: it does not. A dispersive body turns
     /// spectral transport on (its RGB render uses `ior`, the index at the d line).
     #[serde(default)]
@@ -212,93 +246,13 @@ impl PhaseDesc {
     }
 }
 
-/// A body's dispersion law (the index at the d line, 587.56 nm, is the body's `ior`).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub enum DispersionDesc {
-    /// Abbe number `V_d = (n_d − 1)/(n_F − n_C)`, 5 ..= 200 (a two-term Cauchy law through `ior`).
-    Abbe(f32),
-    /// `n(λ) = A + B/λ² + C/λ⁴` (λ in µm) with `A` chosen so that `n(587.56 nm) = ior`.
-    Cauchy {
-        /// `B`, µm², 0 ..= 0.1.
-        b: f32,
-        /// `C`, µm⁴, 0 ..= 0.01 (default 0).
-        #[serde(default)]
-        c: f32,
-    },
-    /// `n² = 1 + Σ Bᵢ λ²/(λ² − Cᵢ)` (λ in µm; `Cᵢ` in µm²): its index at 587.56 nm must equal
-    /// `ior` within 0.001.
-    Sellmeier {
-        /// `B₁, B₂, B₃`, each 0 ..= 10.
-        b: (f32, f32, f32),
-        /// `C₁, C₂, C₃`, µm², each 0 ..= 1000.
-        c: (f32, f32, f32),
-    },
-}
-
 impl BodyDesc {
     /// The body's index as a function of the wavelength (`None`: not dispersive), or what is
-    /// wrong with the law.
+    /// wrong with the law ([`DispersionDesc::law`]).
     pub fn ior_law(&self) -> Result<Option<Ior>, String> {
-        let Some(d) = self.dispersion else {
-            return Ok(None);
-        };
-        let law = match d {
-            DispersionDesc::Abbe(v) => {
-                if !(5.0..=200.0).contains(&v) {
-                    return Err(format!(
-                        "body.dispersion: Abbe number {v} is out of range: allowed 5 ..= 200"
-                    ));
-                }
-                Ior::from_abbe(self.ior, v).ok_or("body.dispersion: Abbe needs ior > 1")?
-            }
-            DispersionDesc::Cauchy { b, c } => {
-                if !(0.0..=0.1).contains(&b) || !(0.0..=0.01).contains(&c) {
-                    return Err(format!(
-                        "body.dispersion: Cauchy b {b} µm², c {c} µm⁴ out of range: allowed \
-                         b 0 ..= 0.1, c 0 ..= 0.01"
-                    ));
-                }
-                let l2 = (LAMBDA_D * 1e-3).powi(2);
-                Ior::Cauchy {
-                    a: self.ior - b / l2 - c / (l2 * l2),
-                    b,
-                    c,
-                }
-            }
-            DispersionDesc::Sellmeier { b, c } => {
-                let (b, c) = ([b.0, b.1, b.2], [c.0, c.1, c.2]);
-                if b.iter().any(|v| !(0.0..=10.0).contains(v))
-                    || c.iter().any(|v| !(0.0..=1000.0).contains(v))
-                {
-                    return Err(format!(
-                        "body.dispersion: Sellmeier b {b:?}, c {c:?} out of range: allowed \
-                         each B 0 ..= 10, each C 0 ..= 1000 µm²"
-                    ));
-                }
-                let law = Ior::Sellmeier { b, c };
-                let n_d = law.at(LAMBDA_D);
-                if (n_d - self.ior).abs() > 1e-3 {
-                    return Err(format!(
-                        "body.dispersion: the Sellmeier law gives {n_d:.5} at 587.56 nm but \
-                         ior is {}: they must agree within 0.001",
-                        self.ior
-                    ));
-                }
-                law
-            }
-        };
-        // Every visible wavelength must see a proper index (no resonance, 1 < n ≤ 4).
-        for l in (360..=830).step_by(5) {
-            let n = law.at(l as f32);
-            if !(n > 1.0 && n <= BODY_IOR.1) {
-                return Err(format!(
-                    "body.dispersion: the law gives n = {n} at {l} nm: allowed 1 <.. 4 over \
-                     360 ..= 830 nm"
-                ));
-            }
-        }
-        Ok(Some(law))
+        self.dispersion
+            .map(|d| d.law(self.ior, BODY_IOR.1))
+            .transpose()
     }
 
     /// The boundary's `α` (0: smooth), or what is wrong.
@@ -335,7 +289,7 @@ impl MediumDesc {
         let spectrum = |what: &str, pts: &Option<SpectrumDesc>| {
             pts.as_ref()
                 .map(|p| {
-                    Measured::from_points(&p.points, SIGMA_MAX)
+                    p.measured(SIGMA_MAX)
                         .map_err(|e| format!("medium.{what}: {e}"))
                 })
                 .transpose()

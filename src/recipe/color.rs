@@ -83,10 +83,11 @@ impl ColorDesc {
     }
 }
 
-/// `s` on the 10 nm grid, its values checked within `0 ..= max`; errors name the file if any.
+/// `s` on the 10 nm grid, its values checked within `0 ..= max`; errors name the CSV file and
+/// line of the offending point ([`SpectrumDesc::measured`]), or the inline point.
 fn grid(s: &SpectrumDesc, max: f32) -> Result<Measured, String> {
-    Measured::from_points(&s.points, max).map_err(|e| match &s.file {
-        Some(f) => format!("Spectrum({f:?}): {e}"),
+    s.measured(max).map_err(|e| match &s.csv {
+        Some(_) => e,
         None => format!("Spectrum: {e}"),
     })
 }

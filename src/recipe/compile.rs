@@ -29,8 +29,11 @@ pub struct Report {
 
 impl GemRecipe {
     /// Checks a file completely: syntax, includes, every material, the whole tree, the stage;
-    /// reports every error it can find (the parser stops at its first error; everything after
-    /// parsing is checked in full).
+    /// reports every error it can find. The parser goes on past a value it refuses (a number out
+    /// of range: recorded with its position, a stand-in read in its place; see
+    /// [`super::source::recover`]), so the checks after parsing run too; it stops at a syntax
+    /// error, an unknown field or a value of the wrong kind, and then only its errors are
+    /// reported.
     pub fn check(path: &Path) -> Report {
         match Source::read(path) {
             Ok(source) => Self::check_source(source, Some(path)),
@@ -327,6 +330,7 @@ impl Compiler<'_> {
             alpha,
             distribution: desc.distribution,
             masking: desc.masking,
+            compensation: desc.compensation,
             medium,
             platelets,
             platelet_materials,

@@ -20,7 +20,7 @@ use super::color::ColorDesc;
 use super::spectrum::SpectrumDesc;
 use crate::spectrum::cie::{LAMBDA_MAX, LAMBDA_MIN};
 use crate::spectrum::fluorescence::Fluorescence;
-use crate::spectrum::measured::Measured;
+use crate::spectrum::measured::{Measured, UNBOUNDED};
 use crate::spectrum::rgb2spec;
 use serde::{Deserialize, Serialize};
 use std::sync::Arc;
@@ -50,13 +50,12 @@ impl FluorescenceDesc {
     /// wrong (naming the field).
     pub(crate) fn compile(&self, albedo: &ColorDesc) -> Result<CompiledFluorescence, String> {
         let field = |name: &str, s: &SpectrumDesc, max: f32| {
-            Measured::from_points(&s.points, max).map_err(|e| match &s.file {
-                Some(f) => format!("base.fluorescence.{name} ({f:?}): {e}"),
-                None => format!("base.fluorescence.{name}: {e}"),
-            })
+            s.measured(max)
+                .map_err(|e| format!("base.fluorescence.{name}: {e}"))
         };
         let excitation = field("excitation", &self.excitation, 1.0)?;
-        let emission = field("emission", &self.emission, f32::MAX)?;
+        // An emission spectrum is a shape (normalised below): any finite value ≥ 0.
+        let emission = field("emission", &self.emission, UNBOUNDED)?;
         let colorant = Fluorescence::new(&excitation, &emission, self.quantum_yield)
             .map_err(|e| format!("base.fluorescence: {e}"))?;
         let substrate: Box<dyn Fn(f32) -> f32> = match albedo.measured(1.0) {

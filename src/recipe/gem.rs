@@ -99,12 +99,13 @@ impl GemRecipe {
         first_error(Self::read(Source::new(file, text), Some(Path::new(file))))
     }
 
-    /// Parses and resolves includes, collecting every error.
+    /// Parses and resolves includes, collecting every error: the parser's (which go on past a
+    /// value out of range, with a stand-in), then the includes' and the materials'. The recipe is
+    /// `None` only when the parser stopped.
     pub(super) fn read(source: Source, path: Option<&Path>) -> (Option<Self>, Vec<RecipeError>) {
-        let mut errors = vec![];
-        let content: GemDesc = match super::ranged::parse(&source) {
-            Ok(c) => c,
-            Err(e) => return (None, vec![e]),
+        let (content, mut errors) = super::ranged::parse::<GemDesc>(&source);
+        let Some(content) = content else {
+            return (None, errors);
         };
         let library = MaterialLibrary::assemble(
             source.clone(),

@@ -57,15 +57,20 @@ impl MaterialLibrary {
         }
     }
 
-    /// Reads a library file and its includes, collecting every error found (the library is
-    /// `None` only when the root file cannot be read or parsed).
+    /// Reads a library file and its includes, collecting every error found: values the parser
+    /// refused (it goes on past them, [`super::source::recover`]), includes, every material. The
+    /// library is `None` only when the root file cannot be read or the parser stopped in it.
     pub fn check(path: &Path) -> (Option<Self>, Vec<RecipeError>) {
+        match Source::read(path) {
+            Ok(source) => Self::check_source(source, Some(path)),
+            Err(e) => (None, vec![e]),
+        }
+    }
+
+    /// [`MaterialLibrary::check`] over text already in memory; includes are relative to `path`.
+    pub fn check_source(source: Source, path: Option<&Path>) -> (Option<Self>, Vec<RecipeError>) {
         let mut errors = vec![];
-        let source = match Source::read(path) {
-            Ok(s) => s,
-            Err(e) => return (None, vec![e]),
-        };
-        let lib = Self::from_source(source, Some(path), &mut errors);
+        let lib = Self::from_source(source, path, &mut errors);
         (lib, errors)
     }
 
@@ -90,13 +95,9 @@ impl MaterialLibrary {
         path: Option<&Path>,
         errors: &mut Vec<RecipeError>,
     ) -> Option<Self> {
-        let content: MaterialFile = match super::ranged::parse(&source) {
-            Ok(c) => c,
-            Err(e) => {
-                errors.push(e);
-                return None;
-            }
-        };
+        let (content, mut found) = super::ranged::parse::<MaterialFile>(&source);
+        errors.append(&mut found);
+        let content = content?;
         let lib = Self::assemble(source, path, content.include, content.materials, errors);
         lib.check_all(errors);
         Some(lib)
@@ -179,12 +180,10 @@ impl MaterialLibrary {
                     continue;
                 }
             };
-            let content: MaterialFile = match super::ranged::parse(&source) {
-                Ok(c) => c,
-                Err(e) => {
-                    errors.push(e);
-                    continue;
-                }
+            let (content, mut found) = super::ranged::parse::<MaterialFile>(&source);
+            errors.append(&mut found);
+            let Some(content) = content else {
+                continue;
             };
             self.sources.push(source);
             let index = self.sources.len() - 1;

@@ -4,13 +4,16 @@
 //! Material libraries (`materials/*.ron`: names → layered stacks, with includes), gem recipes
 //! (`gems/*.ron`: materials, the surface map tree, an optional stage) and the checks that turn them
 //! into runtime [`crate::scene`] tables. Every error names `file:line:col`, what is wrong and, for
-//! numbers, the allowed range; no input makes it panic (a fuzz target feeds it random bytes).
+//! numbers, the allowed range; no input makes it panic (a fuzz target feeds it random bytes). A
+//! number out of range does not stop the parser ([`source::recover`]), so one check reports every
+//! error it can find.
 
 #[macro_use]
 mod ranged;
 pub mod body;
 pub mod color;
 mod compile;
+pub mod dispersion;
 pub mod fluorescence;
 pub mod gem;
 pub mod library;

@@ -25,6 +25,7 @@
 //! ([`crate::platelet::modulation`]). Its numbers are range-checked as a Switch's are; a field that
 //! cannot exceed 0 anywhere (an empty population) is an error.
 
+use super::ranged::refuse;
 use super::surface::FieldDesc;
 use serde::{Deserialize, Deserializer, Serialize};
 
@@ -42,9 +43,23 @@ fn radius_range<'de, D: Deserializer<'de>>(d: D) -> Result<(f32, f32), D::Error>
     if v.0 > 0.0 && v.1 >= v.0 && v.1 <= 1e3 && v.0.is_finite() && v.1.is_finite() {
         Ok(v)
     } else {
-        Err(serde::de::Error::custom(format!(
-            "platelets.radius = {v:?}: needs 0 < smallest <= largest <= 1000 (object units)"
-        )))
+        // Stand-in: each radius within 0 <.. 1000 (0.01 for one at or below 0), in order.
+        let f = |r: f32| {
+            if r > 1e3 {
+                1e3
+            } else if r > 0.0 {
+                r
+            } else {
+                0.01
+            }
+        };
+        let (a, b) = (f(v.0), f(v.1));
+        refuse(
+            format!(
+                "platelets.radius = {v:?}: needs 0 < smallest <= largest <= 1000 (object units)"
+            ),
+            (a.min(b), a.max(b)),
+        )
     }
 }
 

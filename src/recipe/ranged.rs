@@ -1,20 +1,32 @@
-//! Range-checked deserializers: a number outside its range is rejected while it is read, so the
-//! RON parser reports the error at the number itself (`file:line:col`), naming the field and the
-//! allowed range.
+//! Range-checked deserializers: a number outside its range is refused while it is read, naming
+//! the field and the allowed range. The refusal does not stop the parser ([`refuse`]: the error is
+//! recorded, located at the number itself (`file:line:col`) and replaced by a stand-in), so one
+//! check reports every such number; [`parse`] returns them all.
 
-/// Declares a deserializer for an `f32` field that rejects values outside `lo ..= hi` (or, with
-/// `open`, `lo <.. hi`), naming the field and the range.
+pub(crate) use super::source::recover::refuse;
+
+/// Declares a deserializer for an `f32` field that refuses values outside `lo ..= hi` (or, with
+/// `open`, `lo <.. hi`), naming the field and the range. The stand-in for a refused value
+/// ([`refuse`]) is the nearest allowed one (below an open bound: `lo + 1` within the range; NaN:
+/// as if below), or the one given after `else` (a field whose nearest value could raise errors of
+/// its own, such as a `fill` below 1 making a surface transparent).
 macro_rules! ranged {
     ($fn:ident, $name:literal, $lo:expr, $hi:expr) => {
+        ranged!($fn, $name, $lo, $hi, else |v: f32| if v > $hi { $hi } else { $lo });
+    };
+    ($fn:ident, $name:literal, $lo:expr, $hi:expr, else $stand_in:expr) => {
         fn $fn<'de, D: Deserializer<'de>>(d: D) -> Result<f32, D::Error> {
             let v = f32::deserialize(d)?;
             if (($lo)..=($hi)).contains(&v) {
                 Ok(v)
             } else {
-                Err(serde::de::Error::custom(format!(
-                    "{} = {v} is out of range: allowed {} ..= {}",
-                    $name, $lo, $hi
-                )))
+                $crate::recipe::ranged::refuse(
+                    format!(
+                        "{} = {v} is out of range: allowed {} ..= {}",
+                        $name, $lo, $hi
+                    ),
+                    ($stand_in)(v),
+                )
             }
         }
     };
@@ -24,38 +36,66 @@ macro_rules! ranged {
             if v > $lo && v <= $hi {
                 Ok(v)
             } else {
-                Err(serde::de::Error::custom(format!(
-                    "{} = {v} is out of range: allowed {} <.. {}",
-                    $name, $lo, $hi
-                )))
+                $crate::recipe::ranged::refuse(
+                    format!(
+                        "{} = {v} is out of range: allowed {} <.. {}",
+                        $name, $lo, $hi
+                    ),
+                    if v > $hi {
+                        $hi
+                    } else {
+                        f32::min($lo + 1.0, $hi)
+                    },
+                )
             }
         }
     };
 }
 
-/// A finite `f32`.
+/// A finite `f32` (stand-in 0).
 pub(crate) fn finite<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f32, D::Error> {
     let v = <f32 as serde::Deserialize>::deserialize(d)?;
     if v.is_finite() {
         Ok(v)
     } else {
-        Err(serde::de::Error::custom(format!(
-            "{v} must be a finite number"
-        )))
+        refuse(format!("{v} must be a finite number"), 0.0)
     }
 }
 
-/// Sizes (each `0 <.. 1e4`), given as a tuple's components.
+/// Largest size (of a light, a cabochon, a slab), object units.
+const MAX_SIZE: f32 = 1e4;
+
+/// Sizes (each `0 <.. 1e4`), given as a tuple's components (`shown`, for the message); a refused
+/// size is replaced by the nearest allowed one (1 for one at or below 0).
 pub(crate) fn sizes_ok<E: serde::de::Error>(
-    v: &[f32],
+    v: &mut [f32],
     shown: impl std::fmt::Debug,
 ) -> Result<(), E> {
-    if v.iter().all(|x| *x > 0.0 && *x <= 1e4) {
-        Ok(())
-    } else {
-        Err(E::custom(format!(
-            "{shown:?} is out of range: each size allowed 0 <.. 1e4"
-        )))
+    if v.iter().all(|x| *x > 0.0 && *x <= MAX_SIZE) {
+        return Ok(());
+    }
+    refuse(
+        format!("{shown:?} is out of range: each size allowed 0 <.. 1e4"),
+        (),
+    )?;
+    for x in v {
+        *x = if *x > MAX_SIZE {
+            MAX_SIZE
+        } else if *x > 0.0 {
+            *x
+        } else {
+            1.0
+        };
+    }
+    Ok(())
+}
+
+/// A whole-number bound as written in messages: the largest `u64` and `u32` as powers of two.
+pub(crate) fn whole_bound(v: u64) -> String {
+    match v {
+        u64::MAX => "2⁶⁴ − 1".into(),
+        0xffff_ffff => "2³² − 1".into(),
+        v => v.to_string(),
     }
 }
 
@@ -75,42 +115,61 @@ pub(crate) fn whole<'de, D: serde::Deserializer<'de>>(
         hi: u64,
     }
     impl Visit {
-        fn out<E: serde::de::Error>(&self, v: impl std::fmt::Display) -> E {
-            E::custom(format!(
-                "{} = {v} is out of range: allowed {} ..= {} (a whole number)",
-                self.name, self.lo, self.hi
-            ))
+        /// Refuses `v` (shown as given); the stand-in is the nearest bound (`above` it or not).
+        fn out<E: serde::de::Error>(
+            &self,
+            v: impl std::fmt::Display,
+            above: bool,
+        ) -> Result<u64, E> {
+            refuse(
+                format!(
+                    "{} = {v} is out of range: allowed {} ..= {} (a whole number)",
+                    self.name,
+                    whole_bound(self.lo),
+                    whole_bound(self.hi)
+                ),
+                if above { self.hi } else { self.lo },
+            )
         }
     }
     impl<'de> serde::de::Visitor<'de> for Visit {
         type Value = u64;
         fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-            write!(f, "a whole number {} ..= {}", self.lo, self.hi)
+            write!(
+                f,
+                "a whole number {} ..= {}",
+                whole_bound(self.lo),
+                whole_bound(self.hi)
+            )
         }
         fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<u64, E> {
             if (self.lo..=self.hi).contains(&v) {
                 Ok(v)
             } else {
-                Err(self.out(v))
+                self.out(v, v > self.hi)
             }
         }
         fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<u64, E> {
             match u64::try_from(v) {
                 Ok(u) => self.visit_u64(u),
-                Err(_) => Err(self.out(v)),
+                Err(_) => self.out(v, false),
             }
         }
         fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<u64, E> {
-            if v.fract() == 0.0 && v >= self.lo as f64 && v <= self.hi as f64 {
-                Err(E::custom(format!(
-                    "{} = {v:?}: write a whole number, without a decimal point or exponent",
-                    self.name
-                )))
+            let above = v > self.hi as f64;
+            if v.fract() == 0.0 && v >= self.lo as f64 && !above {
+                refuse(
+                    format!(
+                        "{} = {v:?}: write a whole number, without a decimal point or exponent",
+                        self.name
+                    ),
+                    v as u64,
+                )
             } else if v.abs() >= 9e15 {
                 // Beyond 2⁵³ the parser's float is not the literal's exact value.
-                Err(self.out(format!("{v:e}")))
+                self.out(format!("{v:e}"), above)
             } else {
-                Err(self.out(v))
+                self.out(v, above)
             }
         }
     }
@@ -155,21 +214,25 @@ pub(crate) fn check_nesting(source: &super::Source) -> Result<(), super::RecipeE
 
 /// Parses description text with the project's RON options, after the text's own checks
 /// ([`super::Source::check_text`]) and [`check_nesting`], on a thread with a stack deep enough
-/// for every nesting the checks admit.
-pub(crate) fn parse<T>(source: &super::Source) -> Result<T, super::RecipeError>
+/// for every nesting the checks admit, recovering from value errors
+/// ([`super::Source::recovering`]): the value when the parser got to the end, and every error
+/// found (a value may come with value errors).
+pub(crate) fn parse<T>(source: &super::Source) -> (Option<T>, Vec<super::RecipeError>)
 where
     T: serde::de::DeserializeOwned + Send,
 {
-    source.check_text()?;
-    check_nesting(source)?;
+    if let Err(e) = source.check_text().and_then(|()| check_nesting(source)) {
+        return (None, vec![e]);
+    }
     // Spectrum files are read relative to the description's folder.
     let base = std::path::Path::new(&source.file).parent();
     let run = || {
         super::spectrum::with_base(base, || {
-            super::ron_options()
-                .with_recursion_limit(RON_RECURSION_LIMIT)
-                .from_str::<T>(&source.text)
-                .map_err(|e| source.ron_error(&e))
+            source.recovering(|text| {
+                super::ron_options()
+                    .with_recursion_limit(RON_RECURSION_LIMIT)
+                    .from_str::<T>(text)
+            })
         })
     };
     std::thread::scope(|s| {
@@ -305,9 +368,13 @@ where
             let mut out = indexmap::IndexMap::new();
             while let Some(key) = m.next_key::<String>()? {
                 if out.contains_key(&key) {
-                    return Err(serde::de::Error::custom(format!(
-                        "\"{key}\" is defined twice; names must be unique"
-                    )));
+                    // The second definition is read (its own errors are reported) and dropped.
+                    refuse(
+                        format!("\"{key}\" is defined twice; names must be unique"),
+                        (),
+                    )?;
+                    m.next_value::<V>()?;
+                    continue;
                 }
                 if out.len() == self.max {
                     return Err(serde::de::Error::custom(format!(
@@ -327,4 +394,76 @@ where
         value: std::marker::PhantomData,
     })
     .map(|b| b.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::surface::{FieldDesc, MapDesc, SwitchDesc};
+    use super::super::{Source, ron_options};
+
+    /// Parses a map node recovering from value errors: the node and the errors' messages.
+    fn recover(text: &str) -> (Option<MapDesc>, Vec<String>) {
+        let (map, errors) =
+            Source::new("m.ron", text).recovering(|t| ron_options().from_str::<MapDesc>(t));
+        (map, errors.into_iter().map(|e| e.message).collect())
+    }
+
+    #[test]
+    fn refused_values_are_replaced_by_allowed_stand_ins() {
+        let (map, errors) = recover(
+            "Voronoi(scale: 0.0, jitter: 2.0, fill: -0.5, seed: -1, \
+             entries: [(0.0, Material(\"a\")), (1e9, Material(\"b\"))])",
+        );
+        assert_eq!(errors.len(), 6, "{errors:#?}");
+        let Some(MapDesc::Voronoi {
+            scale,
+            jitter,
+            fill,
+            seed,
+            entries,
+            ..
+        }) = map
+        else {
+            panic!("a Voronoi: {map:?}");
+        };
+        // The nearest allowed value; `fill` its default (a lower one makes cells transparent).
+        assert_eq!((scale, jitter, fill, seed), (1e-4, 1.0, 1.0, Some(0)));
+        assert_eq!((entries[0].0.0, entries[1].0.0), (1.0, 1.0));
+
+        let (map, errors) = recover(
+            "Switch(by: Perlin(scale: 1.0, octaves: 40, lacunarity: 1.0), \
+             stops: [(0.5, Material(\"a\")), (0.2, Material(\"b\"))], blend: 3.0)",
+        );
+        assert_eq!(errors.len(), 3, "{errors:#?}");
+        assert!(errors[2].contains("strictly ascending"), "{errors:#?}");
+        let Some(MapDesc::Switch(SwitchDesc(s))) = map else {
+            panic!("a Switch: {map:?}");
+        };
+        let FieldDesc::Perlin {
+            octaves,
+            lacunarity,
+            ..
+        } = s.by
+        else {
+            panic!("Perlin: {:?}", s.by);
+        };
+        // Below an open bound: one above it.
+        assert_eq!((octaves, lacunarity), (16, 2.0));
+        let t: Vec<f32> = s.stops.iter().map(|(t, _)| *t).collect();
+        assert_eq!((t, s.blend), (vec![0.0, 1.0], 0.0));
+        assert!(SwitchDesc::try_from(s).is_ok());
+    }
+
+    #[test]
+    fn shape_errors_still_stop_the_parser() {
+        // An empty `stops` and an unknown field: the value errors before them are kept.
+        for (text, last) in [
+            ("Switch(by: Constant(inf), stops: [])", "`stops` is empty"),
+            ("Voronoi(scale: 0.0, size: 1.0, entries: [])", "`size`"),
+        ] {
+            let (map, errors) = recover(text);
+            assert!(map.is_none() && errors.len() == 2, "{text}: {errors:#?}");
+            assert!(errors[1].contains(last), "{text}: {errors:#?}");
+        }
+    }
 }

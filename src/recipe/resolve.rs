@@ -14,7 +14,6 @@ use crate::scene::stage::{
     Stage, placement, rect_light,
 };
 use crate::scene::{Effect, Effects};
-use crate::spectrum::measured::Measured;
 use glam::Vec3;
 use std::path::PathBuf;
 
@@ -202,7 +201,7 @@ pub(crate) fn stage(
                         let at = at.and_then(|a| src.find_from(a, &["spectrum", ":"])).or(at);
                         src.error(at, format!("stage.lights[{i}].spectrum: {m}"))
                     };
-                    match Measured::from_points(&points.points, 1e9) {
+                    match points.measured(1e9) {
                         Err(m) => {
                             errors.push(fail(m));
                             continue;

@@ -1,6 +1,7 @@
 //! A description file's text and the positions of things in it.
 //!
-//! The RON parser reports positions for syntax and range errors it finds while reading. Errors found
+//! The RON parser reports positions for syntax and range errors it finds while reading (a range
+//! error does not stop it: [`recover`] records it and locates it by parsing again). Errors found
 //! after parsing (an unknown material name, an include that is missing, a bad coat) are located by
 //! searching the text for the tokens that name them, skipping comments and the insides of other
 //! strings, so a name quoted in a comment never attracts an error.
@@ -10,6 +11,7 @@ use std::ops::Range;
 
 pub mod index;
 mod odd;
+pub mod recover;
 
 /// Largest description file read (bytes): recipes are hand-written text, and the limit keeps a
 /// mistaken include of a huge or endless file (`/dev/zero`) from exhausting memory.
@@ -104,6 +106,18 @@ impl Source {
     /// errors just after the `:` (on the blank before the value), and checks made once a whole
     /// tuple or struct was read (`finite3`, a `Switch`'s thresholds) at its closing parenthesis.
     pub fn ron_error(&self, e: &ron::error::SpannedError) -> RecipeError {
+        let mut error = self.value_error(e);
+        if let Some(open) = self.unclosed() {
+            let (l, c) = line_col(&self.text, open);
+            let ch = &self.text[open..=open];
+            error.message += &format!(" (note: the `{ch}` at {l}:{c} is never closed)");
+        }
+        error
+    }
+
+    /// [`Source::ron_error`] without the note on a bracket never closed: for a value error
+    /// located while recovering ([`recover`]), which is not where the parser stopped.
+    pub(crate) fn value_error(&self, e: &ron::error::SpannedError) -> RecipeError {
         let message = e.code.to_string();
         let reported = self.offset(e.span.start.line, e.span.start.col);
         let mut pos = self.skip_blank(reported);
@@ -141,11 +155,6 @@ impl Source {
             if !token.trim().is_empty() {
                 message += &format!(", found `{}`", token.trim());
             }
-        }
-        if let Some(open) = self.unclosed() {
-            let (l, c) = line_col(&self.text, open);
-            let ch = &self.text[open..=open];
-            message += &format!(" (note: the `{ch}` at {l}:{c} is never closed)");
         }
         let (line, col) = line_col(&self.text, pos);
         RecipeError {

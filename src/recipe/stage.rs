@@ -20,7 +20,7 @@
 
 use super::color::ColorDesc;
 use super::material::ModelDesc;
-use super::ranged::{finite, sizes_ok, whole};
+use super::ranged::{finite, refuse, sizes_ok, whole};
 use crate::bsdf::{Distribution, FresnelMode, Masking};
 use indexmap::IndexMap;
 use serde::{Deserialize, Deserializer, Serialize};
@@ -61,20 +61,24 @@ fn finite3<'de, D: Deserializer<'de>>(d: D) -> Result<V3, D::Error> {
     if v.0.is_finite() && v.1.is_finite() && v.2.is_finite() {
         Ok(v)
     } else {
-        Err(serde::de::Error::custom(format!(
-            "{v:?}: every coordinate must be a finite number"
-        )))
+        let f = |c: f32| if c.is_finite() { c } else { 0.0 };
+        refuse(
+            format!("{v:?}: every coordinate must be a finite number"),
+            (f(v.0), f(v.1), f(v.2)),
+        )
     }
 }
 
 fn positive2<'de, D: Deserializer<'de>>(d: D) -> Result<(f32, f32), D::Error> {
     let v = <(f32, f32)>::deserialize(d)?;
-    sizes_ok(&[v.0, v.1], v).map(|()| v)
+    let mut s = [v.0, v.1];
+    sizes_ok(&mut s, v).map(|()| (s[0], s[1]))
 }
 
 fn positive3<'de, D: Deserializer<'de>>(d: D) -> Result<V3, D::Error> {
     let v = V3::deserialize(d)?;
-    sizes_ok(&[v.0, v.1, v.2], v).map(|()| v)
+    let mut s = [v.0, v.1, v.2];
+    sizes_ok(&mut s, v).map(|()| (s[0], s[1], s[2]))
 }
 
 fn base_range<'de, D: Deserializer<'de>>(d: D) -> Result<f32, D::Error> {
@@ -82,9 +86,10 @@ fn base_range<'de, D: Deserializer<'de>>(d: D) -> Result<f32, D::Error> {
     if (0.0..=1e4).contains(&v) {
         Ok(v)
     } else {
-        Err(serde::de::Error::custom(format!(
-            "base = {v} is out of range: allowed 0 ..= 1e4 (0: a flat base)"
-        )))
+        refuse(
+            format!("base = {v} is out of range: allowed 0 ..= 1e4 (0: a flat base)"),
+            if v > 1e4 { 1e4 } else { 0.0 },
+        )
     }
 }
 
@@ -96,19 +101,26 @@ pub const MAX_RADIANCE: f32 = 1e6;
 /// A colour that is emitted light: within 0 ..= [`MAX_RADIANCE`] in every channel.
 fn radiance<'de, D: Deserializer<'de>>(d: D) -> Result<ColorDesc, D::Error> {
     let c = ColorDesc::deserialize(d)?;
+    // The stand-in for a refused colour.
+    let white = ColorDesc::Gray(1.0);
     if let ColorDesc::Spectrum(_) = c {
-        return Err(serde::de::Error::custom(
+        return refuse(
             "an emitted colour cannot be a `Spectrum(…)` (a reflectance's projection): give an \
-             RGB colour, and for a light its measured emission as `spectrum: [(nm, value), …]`",
-        ));
+             RGB colour, and for a light its measured emission as `spectrum: [(nm, value), …]`"
+                .into(),
+            white,
+        );
     }
     match c.to_rgb() {
         Ok(s) if s.0.iter().all(|v| (0.0..=MAX_RADIANCE).contains(v)) => Ok(c),
-        Ok(s) => Err(serde::de::Error::custom(format!(
-            "radiance {:?} is out of range: each channel allowed 0 ..= {MAX_RADIANCE:e}",
-            s.0
-        ))),
-        Err(e) => Err(serde::de::Error::custom(e)),
+        Ok(s) => refuse(
+            format!(
+                "radiance {:?} is out of range: each channel allowed 0 ..= {MAX_RADIANCE:e}",
+                s.0
+            ),
+            white,
+        ),
+        Err(e) => refuse(e, white),
     }
 }
 
@@ -116,18 +128,23 @@ fn radiance<'de, D: Deserializer<'de>>(d: D) -> Result<ColorDesc, D::Error> {
 fn albedo<'de, D: Deserializer<'de>>(d: D) -> Result<ColorDesc, D::Error> {
     let c = ColorDesc::deserialize(d)?;
     if let ColorDesc::Spectrum(_) = c {
-        return Err(serde::de::Error::custom(
+        return refuse(
             "the floor's albedo cannot be a `Spectrum(…)`: give an RGB colour (measured albedos \
-             belong to a material's base)",
-        ));
+             belong to a material's base)"
+                .into(),
+            grey_half(),
+        );
     }
     match c.to_rgb() {
         Ok(s) if s.0.iter().all(|v| (0.0..=1.0).contains(v)) => Ok(c),
-        Ok(s) => Err(serde::de::Error::custom(format!(
-            "albedo {:?} is out of range: each channel allowed 0 ..= 1",
-            s.0
-        ))),
-        Err(e) => Err(serde::de::Error::custom(e)),
+        Ok(s) => refuse(
+            format!(
+                "albedo {:?} is out of range: each channel allowed 0 ..= 1",
+                s.0
+            ),
+            grey_half(),
+        ),
+        Err(e) => refuse(e, grey_half()),
     }
 }
 
@@ -460,9 +477,11 @@ fn focus_range<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f32>, D::Error>
     if v > 0.0 && v <= 1e6 {
         Ok(Some(v))
     } else {
-        Err(serde::de::Error::custom(format!(
-            "focus_distance = {v} is out of range: allowed 0 <.. 1e6"
-        )))
+        // Stand-in: the default (the distance to `to`).
+        refuse(
+            format!("focus_distance = {v} is out of range: allowed 0 <.. 1e6"),
+            None,
+        )
     }
 }
 

@@ -19,12 +19,13 @@
 //! Every number is range-checked while it is read, so an error points at the number itself
 //! (`file:line:col`); the allowed ranges are listed in `docs/recipes.md`.
 
-use super::ranged::finite;
+use super::ranged::{finite, refuse};
 use serde::{Deserialize, Deserializer, Serialize};
 
 ranged!(scale_range, "scale", 1e-4, 1e4);
 ranged!(jitter_range, "jitter", 0.0, 1.0);
-ranged!(fill_range, "fill", 0.0, 1.0);
+// Stand-in 1 (the default): a nearest value below 1 would make the surface transparent.
+ranged!(fill_range, "fill", 0.0, 1.0, else |_| 1.0);
 ranged!(gain_range, "gain", 0.0, 1.0);
 ranged!(lacunarity_range, "lacunarity", open 1.0, 8.0);
 ranged!(turbulence_range, "turbulence", 0.0, 100.0);
@@ -36,9 +37,10 @@ fn octaves_range<'de, D: Deserializer<'de>>(d: D) -> Result<u32, D::Error> {
     if (1..=16).contains(&v) {
         Ok(v)
     } else {
-        Err(serde::de::Error::custom(format!(
-            "octaves = {v} is out of range: allowed 1 ..= 16"
-        )))
+        refuse(
+            format!("octaves = {v} is out of range: allowed 1 ..= 16"),
+            v.clamp(1, 16),
+        )
     }
 }
 
@@ -48,9 +50,10 @@ pub(super) fn axis_check<'de, D: Deserializer<'de>>(d: D) -> Result<(f32, f32, f
     if len.is_finite() && len > 1e-6 {
         Ok(v)
     } else {
-        Err(serde::de::Error::custom(format!(
-            "axis = {v:?} must be a finite, non-zero direction"
-        )))
+        refuse(
+            format!("axis = {v:?} must be a finite, non-zero direction"),
+            x_axis(),
+        )
     }
 }
 
@@ -83,9 +86,10 @@ fn interval<'de, D: Deserializer<'de>>(d: D) -> Result<(f32, f32), D::Error> {
     if v.0.is_finite() && v.1.is_finite() && v.0 != v.1 {
         Ok(v)
     } else {
-        Err(serde::de::Error::custom(format!(
-            "{v:?} must be two finite, different numbers"
-        )))
+        refuse(
+            format!("{v:?} must be two finite, different numbers"),
+            (0.0, 1.0),
+        )
     }
 }
 
@@ -94,7 +98,7 @@ fn finite_pair<'de, D: Deserializer<'de>>(d: D) -> Result<(f32, f32), D::Error> 
     if v.0.is_finite() && v.1.is_finite() {
         Ok(v)
     } else {
-        Err(serde::de::Error::custom(format!("{v:?} must be finite")))
+        refuse(format!("{v:?} must be finite"), (0.0, 1.0))
     }
 }
 
@@ -118,9 +122,17 @@ fn x_axis() -> (f32, f32, f32) {
 }
 
 /// A Voronoi entry's weight: finite and `0 <.. 1e6`.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(try_from = "f32", into = "f32")]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[serde(into = "f32")]
 pub struct Weight(pub f32);
+
+impl<'de> Deserialize<'de> for Weight {
+    /// Reads the weight; one out of range is refused (stand-in 1; see
+    /// [`crate::recipe::source::recover`]).
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        Weight::try_from(f32::deserialize(d)?).or_else(|m| refuse(m, Weight(1.0)))
+    }
+}
 
 impl TryFrom<f32> for Weight {
     type Error = String;
@@ -160,7 +172,7 @@ pub enum MapDesc {
         #[serde(default = "one", deserialize_with = "jitter_range")]
         jitter: f32,
         /// Seed; default: derived from the recipe seed and the node's position in the file.
-        #[serde(default)]
+        #[serde(default, deserialize_with = "super::stage::seed_range")]
         seed: Option<u64>,
         /// `(weight, node)` pairs (1 ..= 100 000); each filled cell picks one with probability ∝
         /// weight.
@@ -218,45 +230,81 @@ pub struct SwitchRaw {
 
 /// A checked switch: at least one stop, finite ascending thresholds, a blend band no wider than
 /// the narrowest gap between thresholds.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(try_from = "SwitchRaw", into = "SwitchRaw")]
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(into = "SwitchRaw")]
 pub struct SwitchDesc(pub SwitchRaw);
+
+impl<'de> Deserialize<'de> for SwitchDesc {
+    /// Reads and checks the switch. Empty `stops` stop the parser; bad thresholds or blend are
+    /// refused ([`crate::recipe::source::recover`]) with a stand-in: thresholds 0, 1, 2, … and no
+    /// blend.
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let mut raw = SwitchRaw::deserialize(d)?;
+        match switch_problem(&raw) {
+            None => Ok(SwitchDesc(raw)),
+            Some(m) if raw.stops.is_empty() => Err(serde::de::Error::custom(m)),
+            Some(m) => {
+                for (i, (t, _)) in raw.stops.iter_mut().enumerate() {
+                    *t = i as f32;
+                }
+                raw.blend = 0.0;
+                refuse(m, SwitchDesc(raw))
+            }
+        }
+    }
+}
 
 impl TryFrom<SwitchRaw> for SwitchDesc {
     type Error = String;
     fn try_from(s: SwitchRaw) -> Result<Self, String> {
-        if s.stops.is_empty() {
-            return Err("Switch: `stops` is empty; give at least one (threshold, node)".into());
+        match switch_problem(&s) {
+            None => Ok(SwitchDesc(s)),
+            Some(m) => Err(m),
         }
-        let t: Vec<f32> = s.stops.iter().map(|(t, _)| *t).collect();
-        if let Some(i) = t.iter().position(|v| !v.is_finite()) {
-            return Err(format!(
-                "Switch: stops[{i}] threshold {} is not finite",
-                t[i]
-            ));
-        }
-        if let Some(i) = t.windows(2).position(|w| w[0] >= w[1]) {
-            return Err(format!(
-                "Switch: thresholds must be strictly ascending, but stops[{}] = {} ≥ stops[{}] = {}",
-                i,
-                t[i],
-                i + 1,
-                t[i + 1]
-            ));
-        }
-        let gap = t
-            .windows(2)
-            .map(|w| w[1] - w[0])
-            .fold(f32::INFINITY, f32::min);
-        if !(s.blend >= 0.0 && s.blend.is_finite() && s.blend <= gap) {
-            return Err(format!(
-                "Switch: blend = {} is out of range: allowed 0 ..= {} (the narrowest gap between thresholds)",
-                s.blend,
-                if gap.is_finite() { gap } else { f32::MAX }
-            ));
-        }
-        Ok(SwitchDesc(s))
     }
+}
+
+/// What is wrong with a switch, if anything (see [`SwitchDesc`]).
+fn switch_problem(s: &SwitchRaw) -> Option<String> {
+    if s.stops.is_empty() {
+        return Some("Switch: `stops` is empty; give at least one (threshold, node)".into());
+    }
+    let t: Vec<f32> = s.stops.iter().map(|(t, _)| *t).collect();
+    if let Some(i) = t.iter().position(|v| !v.is_finite()) {
+        return Some(format!(
+            "Switch: stops[{i}] threshold {} is not finite",
+            t[i]
+        ));
+    }
+    if let Some(i) = t.windows(2).position(|w| w[0] >= w[1]) {
+        return Some(format!(
+            "Switch: thresholds must be strictly ascending, but stops[{}] = {} ≥ stops[{}] = {}",
+            i,
+            t[i],
+            i + 1,
+            t[i + 1]
+        ));
+    }
+    let gap = t
+        .windows(2)
+        .map(|w| w[1] - w[0])
+        .fold(f32::INFINITY, f32::min);
+    if !(s.blend >= 0.0 && s.blend.is_finite() && s.blend <= gap) {
+        return Some(if gap.is_finite() {
+            format!(
+                "Switch: blend = {} is out of range: allowed 0 ..= {gap} (the narrowest gap \
+                 between thresholds)",
+                s.blend
+            )
+        } else {
+            format!(
+                "Switch: blend = {} is out of range: allowed any finite value ≥ 0 (one stop: no \
+                 gap between thresholds)",
+                s.blend
+            )
+        });
+    }
+    None
 }
 
 impl From<SwitchDesc> for SwitchRaw {
@@ -286,7 +334,7 @@ pub enum FieldDesc {
         #[serde(default = "two", deserialize_with = "lacunarity_range")]
         lacunarity: f32,
         /// Seed; default derived like a Voronoi's.
-        #[serde(default)]
+        #[serde(default, deserialize_with = "super::stage::seed_range")]
         seed: Option<u64>,
     },
     /// Turbulence `Σ gainᵏ |noise|`, 0 … 1.
@@ -304,7 +352,7 @@ pub enum FieldDesc {
         #[serde(default = "two", deserialize_with = "lacunarity_range")]
         lacunarity: f32,
         /// Seed.
-        #[serde(default)]
+        #[serde(default, deserialize_with = "super::stage::seed_range")]
         seed: Option<u64>,
     },
     /// Marble veins, 0 … 1: `½ + ½ sin(2π(axis·p/scale + turbulence·turb(p/scale)))`.
@@ -328,7 +376,7 @@ pub enum FieldDesc {
         #[serde(default = "two", deserialize_with = "lacunarity_range")]
         lacunarity: f32,
         /// Seed.
-        #[serde(default)]
+        #[serde(default, deserialize_with = "super::stage::seed_range")]
         seed: Option<u64>,
     },
     /// Sum of fields (1 ..= 64 inputs).

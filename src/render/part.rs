@@ -9,6 +9,11 @@
 //! - `lapidary.samples` (the range rendered, `A..B`; shorter than requested if a time limit
 //!   stopped it), `lapidary.samples_requested`, `lapidary.strategy` and `lapidary.exposure`.
 //!
+//! [`Part::read`] believes nothing it can check ([`check`]): the file's type before it is opened,
+//! every attribute the merge uses against the range `lapidary render` accepts, and every pixel's
+//! sums against the part's sample range (kept + dropped samples = the range's length, and sums
+//! no such count of samples can exceed).
+//!
 //! [`merge`] checks that parts belong together — the same values of every key in
 //! [`MUST_AGREE`] and the same size — and that their ranges are disjoint and cover `0..spp`,
 //! naming the files that overlap and the ranges that are missing.
@@ -17,6 +22,10 @@ use super::film::{Film, PixelSums};
 use crate::image::{ExrImage, RawChannel};
 use std::ops::Range;
 use std::path::{Path, PathBuf};
+
+mod check;
+
+pub use self::check::{MAX_RENDER_TIME, check};
 
 /// Attributes every part of one render must share.
 pub const MUST_AGREE: [&str; 11] = [
@@ -46,12 +55,28 @@ pub fn format_range(r: &Range<u32>) -> String {
     format!("{}..{}", r.start, r.end)
 }
 
-/// Parses `A..B` (`A < B`); the error says what was expected.
+/// Most samples per pixel a render takes (`--spp`, a recipe's `spp`): the largest bound of a
+/// sample range.
+pub const MAX_SPP: u32 = 1 << 20;
+
+/// Parses `A..B` (`A < B` ≤ [`MAX_SPP`]); the error says what was expected.
 pub fn parse_range(s: &str) -> Result<Range<u32>, String> {
     let err = || format!("`{s}`: expected a sample range A..B with A < B, e.g. 0..64");
     let (a, b) = s.split_once("..").ok_or_else(err)?;
-    let a: u32 = a.trim().parse().map_err(|_| err())?;
-    let b: u32 = b.trim().parse().map_err(|_| err())?;
+    let bound = |t: &str| -> Result<u32, String> {
+        let t = t.trim();
+        if t.is_empty() || !t.bytes().all(|c| c.is_ascii_digit()) {
+            return Err(err());
+        }
+        match t.parse::<u32>() {
+            Ok(v) if v <= MAX_SPP => Ok(v),
+            _ => Err(format!(
+                "`{s}`: {t} is too large: a sample range lies within 0..{MAX_SPP} (the most \
+                 samples per pixel)"
+            )),
+        }
+    };
+    let (a, b) = (bound(a)?, bound(b)?);
     if a >= b {
         return Err(err());
     }
@@ -240,10 +265,13 @@ pub struct Part {
 }
 
 impl Part {
-    /// Reads and checks a part file: readable, with raw channels and a sample range.
+    /// Reads and checks a part file: a regular file (checked before it is opened: a FIFO would
+    /// block), readable, with raw channels and a sample range, whose attributes lie in their
+    /// ranges and agree with its sums ([`check`]). The error lists every problem, one a line.
     pub fn read(path: &Path) -> Result<Part, String> {
-        let (image, raw) = crate::image::read_exr_raw(path).map_err(|e| e.to_string())?;
         let at = |e: String| format!("{}: {e}", path.display());
+        crate::image::input_kind::regular_file(path).map_err(|e| at(e.to_string()))?;
+        let (image, raw) = crate::image::read_exr_raw(path).map_err(|e| e.to_string())?;
         let samples = image
             .attribute("lapidary.samples")
             .ok_or_else(|| {
@@ -254,6 +282,10 @@ impl Part {
             })
             .and_then(|s| parse_range(s).map_err(at))?;
         let film = film_from_raw(image.width, image.height, &raw).map_err(at)?;
+        let problems = check(&image, &film, &samples);
+        if !problems.is_empty() {
+            return Err(problems.into_iter().map(at).collect::<Vec<_>>().join("\n"));
+        }
         Ok(Part {
             path: path.to_path_buf(),
             image,
@@ -364,6 +396,17 @@ pub fn merge(mut parts: Vec<Part>) -> Result<Merged, String> {
     if !problems.is_empty() {
         return Err(problems.join("\n"));
     }
+    // Rays are the one sum no range bounds: forged counts must not overflow.
+    let rays = |i: usize| {
+        parts
+            .iter()
+            .try_fold(0u64, |a, p| a.checked_add(p.film.pixels[i].rays))
+    };
+    if let Some(i) = (0..parts[0].film.pixels.len()).find(|&i| rays(i).is_none()) {
+        return Err(format!(
+            "the parts' `raw.rays` of pixel {i} add up to more than 2^64: not rays a render traced"
+        ));
+    }
     let mut film = parts[0].film.clone();
     for p in &parts[1..] {
         for (a, b) in film.pixels.iter_mut().zip(&p.film.pixels) {
@@ -414,8 +457,28 @@ mod tests {
     fn ranges_parse_and_refuse_nonsense() {
         assert_eq!(parse_range("0..64"), Ok(0..64));
         assert_eq!(parse_range(" 3 .. 5 "), Ok(3..5));
-        for bad in ["5..5", "6..2", "1-4", "..3", "a..b", "0..4294967296"] {
+        for bad in [
+            "5..5",
+            "6..2",
+            "1-4",
+            "..3",
+            "a..b",
+            "+1..3",
+            "0..4294967296",
+        ] {
             assert!(parse_range(bad).is_err(), "{bad}");
+        }
+        assert_eq!(parse_range("0..1048576"), Ok(0..MAX_SPP));
+        for big in [
+            "0..18446744073709551615",
+            "0..1048577",
+            "99999999999999999999999..3",
+        ] {
+            let e = parse_range(big).unwrap_err();
+            assert!(
+                e.contains("is too large") && e.contains("0..1048576"),
+                "{e}"
+            );
         }
     }
 

@@ -2,6 +2,7 @@
 //! material table, built once from a compiled [`Scene`].
 
 pub use super::setup::{PROGRESS_AFTER, Setup, WorldError};
+use crate::bsdf::layered::ladder::AlbedoLadder;
 use crate::bsdf::{Bsdf, Bxdf, Lambert, LayeredBsdf};
 use crate::color::Rgb;
 use crate::geometry::{MediumId, Ray, Stone, StoneHit};
@@ -206,11 +207,18 @@ impl World {
                     bar.set_draw_target(ProgressDrawTarget::stderr());
                 }
                 bar.inc(1);
-                let mut stack = LayeredBsdf::new(desc).map_err(|source| WorldError::Material {
+                let material = |source| WorldError::Material {
                     name: scene.surface.names[k].clone(),
                     source,
-                })?;
-                stack.force_absorption(scene.effects.forced(Effect::Absorption));
+                };
+                let mut stack = LayeredBsdf::new(desc).map_err(material)?;
+                let absorption = scene.effects.forced(Effect::Absorption);
+                stack.force_absorption(absorption);
+                if scene.effects.on(Effect::Spectral)
+                    && let Some(l) = AlbedoLadder::build(desc, absorption).map_err(material)?
+                {
+                    stack.set_albedo_ladder(l);
+                }
                 let bsdf = Bsdf::from(stack);
                 let albedo = Rgb::from(normal_albedo(&bsdf));
                 Ok(Some((bsdf, albedo)))

@@ -61,8 +61,9 @@ pub struct Accuracy {
     /// Masking–shadowing for every material (`None`: each material's own).
     pub masking: Option<Masking>,
     /// Multiple-scattering energy compensation (Turquin 2019) of every material's conductor base
-    /// (and the Reference walk's interfaces) on or off (`None`: each material's own; it adds
-    /// ~2 % to gold at mid angles against an uncompensated peer, docs/parity.md).
+    /// (and the Reference walk's interfaces), and of a translucent body's rough boundary, on or
+    /// off (`None`: each material's and the body's own; it adds ~2 % to gold at mid angles
+    /// against an uncompensated peer, docs/parity.md).
     pub compensation: Option<bool>,
     /// The Corrected model's albedo calibration to the adding solution on or off (`None`: each
     /// material's own; docs/materials.md measures what it buys).

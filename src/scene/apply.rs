@@ -55,6 +55,9 @@ impl Scene {
             for (_, stack) in &mut body.platelet_materials {
                 acc.apply_to(stack);
             }
+            if let Some(c) = acc.compensation {
+                body.compensation = c;
+            }
         }
         self.effects.clear(Effect::Absorption);
         self.effects.clear(Effect::TTerm);

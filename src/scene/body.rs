@@ -29,6 +29,9 @@ pub struct Body {
     pub distribution: Distribution,
     /// Masking of a rough boundary.
     pub masking: Masking,
+    /// Whether a rough boundary has its multiple-scattering compensation (see
+    /// [`Body::boundary`]); `false` matches peers whose rough dielectric has none.
+    pub compensation: bool,
     /// The interior, coefficients per object unit; `None` is clear.
     pub medium: Option<Interior>,
     /// Platelet populations (object space); their entries index [`Body::platelet_materials`]
@@ -57,7 +60,8 @@ pub struct Interior {
 impl Body {
     /// The boundary's BSDF: a smooth dielectric, or a rough one (Walter et al. 2007) with its
     /// reciprocal multiple-scattering compensation (`bsdf::interface_energy`), so a lossless body
-    /// keeps all the energy that enters it. `eta` is inside over outside.
+    /// keeps all the energy that enters it — unless [`Body::compensation`] is off (the plain
+    /// interface of Mitsuba 3, pbrt-v4 and Cycles). `eta` is inside over outside.
     pub fn boundary(&self) -> Bsdf {
         let law = self.dispersion.map(|inside| Dispersion {
             inside,
@@ -75,7 +79,12 @@ impl Body {
         } else {
             let d = MicrofacetDistribution::from_alpha(self.distribution, self.alpha)
                 .with_masking(self.masking);
-            let mut b = RoughDielectric::new(d, self.ior).with_energy_tables_at(BOUNDARY_GRID);
+            let plain = RoughDielectric::new(d, self.ior);
+            let mut b = if self.compensation {
+                plain.with_energy_tables_at(BOUNDARY_GRID)
+            } else {
+                plain
+            };
             b.dispersion = law;
             Bsdf::Dielectric(b)
         }

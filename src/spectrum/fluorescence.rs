@@ -93,7 +93,11 @@ impl Fluorescence {
             .collect();
         let total: f64 = e.iter().sum();
         if !(total > 0.0) {
-            return Err("the emission spectrum is zero over 360 ..= 830 nm".into());
+            return Err(
+                "the emission spectrum is zero over 360 ..= 830 nm: it must be positive \
+                 somewhere in that range"
+                    .into(),
+            );
         }
         let mut cdf = Vec::with_capacity(CELLS + 1);
         let mut acc = 0.0f64;

@@ -332,6 +332,51 @@ fn furnace_rejects_an_uncompensated_boundary() {
     );
 }
 
+/// The recipe's `compensation: false` (and the `compensation=off` knob) is the plain interface
+/// of the negative control above — the peers' rough dielectric —, bit for bit: the same image
+/// as replacing the boundary by hand, which loses energy in the furnace; the default keeps the
+/// compensated boundary.
+#[test]
+fn the_compensation_switch_gives_the_plain_interface() {
+    let body = "(ior: 2.4, alpha: 0.5, compensation: false)";
+    let c = Config {
+        label: "η 2.4 rough α 0.5 compensation: false".into(),
+        body: body.into(),
+        strategy: Strategy::Mis,
+        scatters: false,
+        rough: true,
+    };
+    let (_, world) = build(&gem(body, &stage(16)));
+    match world.materials.last() {
+        Some(Some(Bsdf::Dielectric(d))) => assert!(d.energy.is_none(), "still compensated"),
+        other => panic!("not a rough boundary: {other:?}"),
+    }
+    let switched = run(&c, 16, Boundary::Recipe);
+    let by_hand = run(
+        &Config {
+            body: "(ior: 2.4, alpha: 0.5)".into(),
+            ..c.clone()
+        },
+        16,
+        Boundary::Uncompensated,
+    );
+    assert_eq!(
+        switched.total.sum, by_hand.total.sum,
+        "not the plain interface"
+    );
+    let mean = switched.total.sum.iter().sum::<f64>() / (3.0 * switched.total.n as f64);
+    assert!(mean < 0.9, "the plain interface keeps its energy: {mean}");
+    // The knob, over a recipe that asks for compensation.
+    let (mut scene, _) = build(&gem("(ior: 2.4, alpha: 0.5)", &stage(16)));
+    let knobs: lapidary::scene::accuracy::Knobs = "compensation=off".parse().unwrap();
+    knobs.apply(&mut scene, "test").unwrap();
+    let world = World::new(&scene).unwrap();
+    match world.materials.last() {
+        Some(Some(Bsdf::Dielectric(d))) => assert!(d.energy.is_none(), "the knob did not reach it"),
+        other => panic!("not a rough boundary: {other:?}"),
+    }
+}
+
 /// 1 048 576 paths per configuration; rough boundaries get compensation tables of 128² · 4
 /// samples per entry, so the furnace tests the integrator and the media rather than the noise of
 /// the default tables (module docs). ≈ 30 s on two cores.

@@ -56,6 +56,7 @@ fn interfaces() -> Vec<(String, RoughDielectric, RoughDielectric)> {
                 alpha,
                 distribution: Distribution::Ggx,
                 masking: Masking::Smith,
+                compensation: true,
                 medium: None,
                 platelets: vec![],
                 platelet_materials: vec![],

@@ -23,6 +23,7 @@ pub mod corrected;
 pub mod course;
 pub mod fluorescent;
 pub mod interface;
+pub mod ladder;
 pub mod reference;
 
 use super::table::Table;
@@ -163,7 +164,8 @@ pub struct StackDesc {
     /// default, off to measure what it buys (`tradeoff` knob `calibration`).
     pub calibration: bool,
     /// A measured albedo spectrum of a Lambert or Oren–Nayar base (the `albedo` above is its RGB
-    /// projection). Spectral renders read it per wavelength when the stack has no coats; a coated
+    /// projection). Spectral renders read it per wavelength: a stack without coats directly, one
+    /// under coats that do not absorb through its albedo ladder ([`ladder`]); otherwise a coated
     /// stack's spectral value is its RGB value as a spectrum ([`crate::bsdf::spectral`]).
     pub base_spectrum: Option<&'static crate::spectrum::measured::Measured>,
     /// A fluorescent colorant in a Lambert base (issue 20, [`fluorescent`]): the base's albedo
@@ -317,6 +319,9 @@ pub struct LayeredBsdf {
     pub(crate) base_spectrum: Option<&'static crate::spectrum::measured::Measured>,
     /// The base's fluorescent colorant ([`fluorescent`]).
     pub(crate) fluorescence: Option<std::sync::Arc<crate::spectrum::fluorescence::Fluorescence>>,
+    /// A measured diffuse base's albedo ladder for spectral paths ([`ladder`]), when the world
+    /// renders spectrally and it applies.
+    pub(crate) ladder: Option<std::sync::Arc<ladder::AlbedoLadder>>,
 }
 
 /// Roughness (degrees) of the placeholder micro-facet lobes a smooth coat carries.
@@ -422,6 +427,7 @@ impl LayeredBsdf {
                 Base::Lambert { .. } => desc.fluorescence.clone(),
                 _ => None,
             },
+            ladder: None,
         };
         for l in (0..stack.levels.len()).rev() {
             corrected::build_tables(&mut stack, l, TABLE_GRID);
@@ -516,6 +522,12 @@ impl LayeredBsdf {
         }
     }
 
+    /// Gives spectral paths the stack at the albedo of the measured base at each wavelength
+    /// ([`ladder`]).
+    pub fn set_albedo_ladder(&mut self, ladder: ladder::AlbedoLadder) {
+        self.ladder = Some(std::sync::Arc::new(ladder));
+    }
+
     /// The same compiled stack evaluated by another model (tables are shared by all models).
     pub fn with_model(&self, model: Model) -> Self {
         let mut s = self.clone();
@@ -562,12 +574,20 @@ pub fn validate(desc: &StackDesc) -> Result<(), StackError> {
             );
         }
         if !(c.thickness >= 0.0 && c.thickness.is_finite()) {
-            return bad(format!("coats[{i}].thickness"), c.thickness, "0 ..= finite");
+            return bad(
+                format!("coats[{i}].thickness"),
+                c.thickness,
+                "any finite value ≥ 0",
+            );
         }
         for ch in 0..3 {
             let a = c.absorption[ch];
             if !(a >= 0.0 && a.is_finite()) {
-                return bad(format!("coats[{i}].absorption[{ch}]"), a, ">= 0, finite");
+                return bad(
+                    format!("coats[{i}].absorption[{ch}]"),
+                    a,
+                    "any finite value ≥ 0",
+                );
             }
         }
     }

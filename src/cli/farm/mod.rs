@@ -11,8 +11,10 @@
 
 pub mod args;
 pub mod regress;
+pub mod render_args;
 pub mod slurm;
 pub mod submit;
+pub mod text;
 
 use clap::{Args, Subcommand};
 

@@ -1,6 +1,7 @@
 //! Writing and submitting Slurm jobs: an array job, a job that depends on it, and `submit.sh`,
 //! which submits both the way `--submit` does.
 
+use super::text::{Text, script_is_clean};
 use anyhow::{Context, Result, anyhow, bail};
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -9,29 +10,63 @@ use std::process::Command;
 /// overwritten.
 pub const MARKER: &str = "# Written by lapidary farm";
 
-/// Writes an executable script (or the farm's record of its part command), replacing only a file
-/// this command wrote before: one whose first or second line is the [`MARKER`].
-pub fn write_script(path: &Path, text: &str) -> Result<()> {
-    if let Ok(old) = std::fs::read_to_string(path) {
-        if !old.lines().take(2).any(|l| l.starts_with(MARKER)) {
-            bail!(
-                "{}: exists and was not written by `lapidary farm`: not replaced (choose another \
-                 --dir)",
-                path.display()
-            );
-        }
-    } else if path.exists() {
+/// Reads a file the farm itself keeps (a script, `parts/command.txt`) if it exists: `None` when
+/// nothing is there. Its type is checked before it is opened: a FIFO would block the read and a
+/// device never end it, so anything but a regular file is refused.
+pub fn read_own(path: &Path) -> Result<Option<String>> {
+    use crate::image::input_kind::{NotAFile, regular_file};
+    match regular_file(path) {
+        Ok(_) => {}
+        Err(NotAFile::Missing) if std::fs::symlink_metadata(path).is_err() => return Ok(None),
+        Err(e) => bail!(
+            "{}: {e}: where the farm keeps a file of its own; not replaced (remove it, or choose \
+             another --dir)",
+            path.display()
+        ),
+    }
+    match std::fs::read_to_string(path) {
+        Ok(text) => Ok(Some(text)),
+        Err(e) => bail!(
+            "{}: exists and is not a text file ({e}): not replaced",
+            path.display()
+        ),
+    }
+}
+
+/// Checks that `path` is free for a script: nothing there, or a file this command wrote before
+/// (one whose first or second line is the [`MARKER`]); returns its text.
+pub fn check_own(path: &Path) -> Result<Option<String>> {
+    let old = read_own(path)?;
+    if let Some(old) = &old
+        && !old.lines().take(2).any(|l| l.starts_with(MARKER))
+    {
         bail!(
-            "{}: exists and is not a text file: not replaced",
+            "{}: exists and was not written by `lapidary farm`: not replaced (choose another \
+             --dir)",
             path.display()
         );
     }
-    crate::image::write_atomically(path, |tmp| {
-        std::fs::write(tmp, text)?;
+    Ok(old)
+}
+
+/// Writes an executable script (or the farm's record of its part command), replacing only a file
+/// this command wrote before ([`check_own`]). The text must be free of control characters but
+/// its line ends ([`script_is_clean`]).
+pub fn write_script(path: &Path, text: &str) -> Result<()> {
+    if !script_is_clean(text) {
+        bail!(
+            "{}: the script would hold a control character: not written",
+            path.display()
+        );
+    }
+    check_own(path)?;
+    crate::image::write_atomically(path, |sink| {
+        use std::io::Write as _;
+        sink.write_all(text.as_bytes())?;
         #[cfg(unix)]
         {
             use std::os::unix::fs::PermissionsExt;
-            std::fs::set_permissions(tmp, std::fs::Permissions::from_mode(0o755))?;
+            std::fs::set_permissions(sink.path(), std::fs::Permissions::from_mode(0o755))?;
         }
         Ok(())
     })
@@ -54,7 +89,7 @@ pub struct Jobs {
     /// that reports failed tasks).
     pub dependency: &'static str,
     /// Options for every `sbatch` call (`--partition=…`).
-    pub sbatch_args: Vec<String>,
+    pub sbatch_args: Vec<Text>,
 }
 
 impl Jobs {
@@ -66,9 +101,10 @@ impl Jobs {
     /// Writes `submit.sh`, which submits the array (if any task is left) and the final job,
     /// printing both job ids. Extra `sbatch` options may be given to it.
     pub fn write_submit_sh(&self) -> Result<PathBuf> {
-        let q = super::shell_quote;
-        let opts: Vec<String> = self.sbatch_args.iter().map(|a| q(a)).collect();
+        let opts: Vec<String> = self.sbatch_args.iter().map(Text::sh).collect();
         let opts = opts.join(" ");
+        let array_script = Text::path(&self.array_script, "the array script")?;
+        let final_script = Text::path(&self.final_script, "the final script")?;
         let mut s = format!(
             "#!/bin/bash\n{MARKER}: submits the array and the job after it; extra sbatch options \
              may be given.\nset -euo pipefail\n"
@@ -77,7 +113,7 @@ impl Jobs {
             s += &format!(
                 "# Every task's output is present: only the final job.\nsbatch --parsable {opts} \
                  \"$@\" {}\n",
-                q(&self.final_script.display().to_string())
+                final_script.sh()
             );
         } else {
             s += &format!(
@@ -85,9 +121,9 @@ impl Jobs {
                  echo \"array job $array\"\n\
                  sbatch --parsable --dependency={}:\"$array\" {opts} \"$@\" {}\n",
                 self.array(),
-                q(&self.array_script.display().to_string()),
+                array_script.sh(),
                 self.dependency,
-                q(&self.final_script.display().to_string())
+                final_script.sh()
             );
         }
         let path = self.dir.join("submit.sh");
@@ -102,7 +138,7 @@ impl Jobs {
             None
         } else {
             let mut args = vec![format!("--array={}", self.array())];
-            args.extend(self.sbatch_args.iter().cloned());
+            args.extend(self.sbatch_args.iter().map(|a| a.as_str().to_string()));
             args.push(self.array_script.display().to_string());
             Some(sbatch(&args)?)
         };
@@ -110,7 +146,7 @@ impl Jobs {
         if let Some(id) = &array {
             args.push(format!("--dependency={}:{id}", self.dependency));
         }
-        args.extend(self.sbatch_args.iter().cloned());
+        args.extend(self.sbatch_args.iter().map(|a| a.as_str().to_string()));
         args.push(self.final_script.display().to_string());
         Ok((array, sbatch(&args)?))
     }

@@ -128,7 +128,10 @@ impl Source {
             return None;
         }
         let range = if field == "seed" {
-            format!(": allowed 0 ..= {} (a whole number)", u64::MAX)
+            format!(
+                ": allowed 0 ..= {} (a whole number)",
+                crate::recipe::ranged::whole_bound(u64::MAX)
+            )
         } else {
             String::from(" for the field (see its range in docs/recipes.md)")
         };
