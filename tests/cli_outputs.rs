@@ -12,7 +12,7 @@ mod scratch;
 use scratch::{Scratch, text};
 #[path = "common/outputs.rs"]
 mod run;
-use run::{SUNSTONE, TINY, lapidary, ok, refused, render};
+use run::{TINY, copy_sunstone, lapidary, ok, refused, render};
 
 #[test]
 fn a_directory_is_never_an_output() {
@@ -98,7 +98,8 @@ fn symlinks_are_written_through_to_their_target() {
         &render(&s, &["-o", "dangling.exr", "--no-png"]),
         "dangling.exr: is a symlink that leads to no file",
     );
-    std::fs::copy(SUNSTONE, s.path("gem.ron")).unwrap();
+    copy_sunstone(&s.path("gem.ron"));
+    let gem = std::fs::read(s.path("gem.ron")).unwrap();
     std::os::unix::fs::symlink("gem.ron", s.path("gem.exr")).unwrap();
     let out = lapidary(
         &s,
@@ -107,10 +108,7 @@ fn symlinks_are_written_through_to_their_target() {
         ],
     );
     refused(&out, "gem.exr: is also an input (the recipe gem.ron)");
-    assert_eq!(
-        std::fs::read(s.path("gem.ron")).unwrap(),
-        std::fs::read(SUNSTONE).unwrap()
-    );
+    assert_eq!(std::fs::read(s.path("gem.ron")).unwrap(), gem);
     assert_eq!(
         s.files(),
         [
@@ -166,8 +164,8 @@ fn a_png_that_cannot_be_written_leaves_the_old_exr() {
 #[test]
 fn no_output_is_an_input_or_another_output() {
     let s = Scratch::new("outputs", "inputs");
-    std::fs::copy(SUNSTONE, s.path("x.ron")).unwrap();
-    let gem = std::fs::read(SUNSTONE).unwrap();
+    copy_sunstone(&s.path("x.ron"));
+    let gem = std::fs::read(s.path("x.ron")).unwrap();
     let tiny = |args: &[&str]| {
         let mut all = vec!["render", "x.ron"];
         all.extend(args);
@@ -260,8 +258,8 @@ fn stale_temporary_files_of_dead_runs_are_removed() {
 #[test]
 fn map_compare_brdf_and_regress_check_their_outputs() {
     let s = Scratch::new("outputs", "commands");
-    std::fs::copy(SUNSTONE, s.path("x.ron")).unwrap();
-    let gem = std::fs::read(SUNSTONE).unwrap();
+    copy_sunstone(&s.path("x.ron"));
+    let gem = std::fs::read(s.path("x.ron")).unwrap();
     refused(
         &lapidary(&s, &["map", "x.ron", "--out", "x.ron"]),
         "x.ron: is also an input",
@@ -289,7 +287,7 @@ fn map_compare_brdf_and_regress_check_their_outputs() {
     #[cfg(unix)]
     {
         std::fs::create_dir(s.path("suite")).unwrap();
-        std::fs::copy(SUNSTONE, s.path("suite/g.ron")).unwrap();
+        copy_sunstone(&s.path("suite/g.ron"));
         assert!(
             Command::new("mkfifo")
                 .arg(s.path("suite/g.exr"))
@@ -338,7 +336,7 @@ fn tradeoff(s: &Scratch, extra: &[&str]) -> Output {
 #[test]
 fn tradeoff_refuses_bad_settings_and_outputs_before_rendering() {
     let s = Scratch::new("outputs", "tradeoff");
-    std::fs::copy(SUNSTONE, s.path("x.ron")).unwrap();
+    copy_sunstone(&s.path("x.ron"));
     for (setting, needle) in [
         ("", "--setting ``: an empty setting"),
         (

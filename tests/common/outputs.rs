@@ -7,6 +7,14 @@ use super::scratch::{Scratch, text};
 use std::process::{Command, Output, Stdio};
 
 pub const SUNSTONE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/gems/sunstone.ron");
+/// Writes a copy of the Sunstone recipe to `dest` whose paths into the repository (its measured
+/// spectrum, `../data/…`) stay valid wherever the copy lies.
+pub fn copy_sunstone(dest: &std::path::Path) {
+    let text = std::fs::read_to_string(SUNSTONE).unwrap();
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/");
+    std::fs::write(dest, text.replace("\"../", &format!("\"{root}"))).unwrap();
+}
+
 /// A render that takes well under a second.
 pub const TINY: [&str; 4] = ["--size", "16x16", "--spp", "1"];
 /// A render whose first pass takes far longer than setup; only ever stopped early.

@@ -3,7 +3,7 @@
 //! pixel's sums are ones that many samples can make. A part that fails is refused by
 //! [`super::Part::read`] with every problem listed.
 
-use super::{MAX_SPP, format_range, parse_range};
+use super::range::{MAX_SPP, format_range, parse_range};
 use crate::image::ExrImage;
 use crate::render::film::{Film, PixelSums};
 use crate::render::fixed;
