@@ -80,6 +80,10 @@ pub struct RenderArgs {
     /// Accuracy knobs (override the recipe's).
     #[command(flatten)]
     pub knobs: super::knobs::KnobArgs,
+    /// The lane path loop (eight paths at a time in SIMD registers, docs/design.md §13) where the
+    /// scene allows it: `off` traces with the scalar loop (the same image bit for bit, slower).
+    #[arg(long, value_parser = super::knobs::switch_arg)]
+    pub lanes: Option<bool>,
     /// No progress bar and no summary.
     #[arg(short, long)]
     pub quiet: bool,
@@ -327,6 +331,7 @@ pub fn run(args: &RenderArgs) -> Result<bool> {
         progress: Some(&progress),
         on_pass: None,
         samples: args.samples.clone(),
+        scalar: args.lanes == Some(false),
     };
     let rendered = render_scene(&world, &scene, &control);
     bar.finish_and_clear();

@@ -20,6 +20,7 @@ pub mod film;
 pub mod filter;
 pub mod fixed;
 pub mod integrator;
+pub mod lanes;
 pub mod manifold;
 pub mod memory;
 pub mod output;
@@ -79,6 +80,9 @@ pub struct Control<'a> {
     /// into the one-machine render bit for bit. An empty or out-of-range end is clamped to
     /// `spp`.
     pub samples: Option<std::ops::Range<u32>>,
+    /// Trace with the scalar path loop even where the lane loop applies ([`lanes`]; both give the
+    /// same image bit for bit: `--lanes off`, for comparisons).
+    pub scalar: bool,
 }
 
 /// Figures of a finished (or stopped) render.
@@ -106,6 +110,36 @@ pub struct Rendered {
     pub film: Film,
     /// Time, paths, rays, drops.
     pub stats: RenderStats,
+}
+
+/// One tile row's pixel sums after the samples `samples` of each pixel, traced by the lane loop
+/// in packets of [`lanes::simd::L`] adjacent pixels, sample by sample (each pixel's samples are
+/// added in order, as the scalar loop adds them).
+fn lane_row(
+    world: &World,
+    setup: &lanes::trace::Setup,
+    row: &[PixelSums],
+    x0: u32,
+    y: u32,
+    samples: std::ops::Range<u32>,
+) -> Vec<PixelSums> {
+    let mut sums = row.to_vec();
+    for (k, chunk) in sums.chunks_mut(lanes::simd::L).enumerate() {
+        let x = x0 + (k * lanes::simd::L) as u32;
+        for s in samples.clone() {
+            let packet = lanes::trace::Packet {
+                x0: x,
+                y,
+                count: chunk.len() as u32,
+                sample: s,
+            };
+            let out = lanes::dispatch(|| lanes::trace_packet(world, setup, packet));
+            for (p, o) in chunk.iter_mut().zip(&out) {
+                p.add(o);
+            }
+        }
+    }
+    sums
 }
 
 /// Samples per pass: small enough that a stopped render has most pixels at the same count, large
@@ -195,6 +229,18 @@ where
         control.cancel.is_some_and(|c| c.load(Ordering::Relaxed))
             || control.deadline.is_some_and(|d| Instant::now() >= d)
     };
+    // The lane loop where it applies (docs/design.md §13): the same samples, bit for bit.
+    let lane_setup =
+        (S::WAVELENGTH_DIMENSIONS == 0 && !control.scalar && lanes::unsupported(world).is_none())
+            .then(|| lanes::trace::Setup {
+                rays: &rays,
+                filter: &filter,
+                sampler: settings.sampler,
+                seed: settings.seed,
+                width: w,
+                max_depth: settings.max_depth,
+                strategy: control.strategy,
+            });
     let step = pass_size(settings.spp);
     let last = control
         .samples
@@ -214,26 +260,39 @@ where
                 let (x1, y1) = ((x0 + TILE).min(w), (y0 + TILE).min(h));
                 let mut sums = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
                 for y in y0..y1 {
-                    for x in x0..x1 {
-                        let mut p = film.pixels[(y * w + x) as usize];
-                        for s in done..end {
-                            let pixel = u64::from(y) * u64::from(w) + u64::from(x);
-                            let mut sampler =
-                                PixelSampler::new(settings.sampler, settings.seed, pixel, s);
-                            let offset = filter.sample(sampler.get2d());
-                            let lens = sampler.get2d();
-                            let film_pt = Vec2::new(x as f32 + 0.5, y as f32 + 0.5) + offset;
-                            let ray = rays.ray(film_pt, lens);
-                            let sample = trace::<S>(
-                                world,
-                                ray,
-                                &mut sampler,
-                                settings.max_depth,
-                                control.strategy,
-                            );
-                            p.add(&sample);
+                    let row = &film.pixels[(y * w + x0) as usize..(y * w + x1) as usize];
+                    match &lane_setup {
+                        Some(setup) => {
+                            sums.extend_from_slice(&lane_row(world, setup, row, x0, y, done..end));
                         }
-                        sums.push(p);
+                        None => {
+                            for (x, &pixel_sums) in (x0..x1).zip(row) {
+                                let mut p = pixel_sums;
+                                for s in done..end {
+                                    let pixel = u64::from(y) * u64::from(w) + u64::from(x);
+                                    let mut sampler = PixelSampler::new(
+                                        settings.sampler,
+                                        settings.seed,
+                                        pixel,
+                                        s,
+                                    );
+                                    let offset = filter.sample(sampler.get2d());
+                                    let lens = sampler.get2d();
+                                    let film_pt =
+                                        Vec2::new(x as f32 + 0.5, y as f32 + 0.5) + offset;
+                                    let ray = rays.ray(film_pt, lens);
+                                    let sample = trace::<S>(
+                                        world,
+                                        ray,
+                                        &mut sampler,
+                                        settings.max_depth,
+                                        control.strategy,
+                                    );
+                                    p.add(&sample);
+                                }
+                                sums.push(p);
+                            }
+                        }
                     }
                 }
                 if let Some(progress) = control.progress {

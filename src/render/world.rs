@@ -1,21 +1,19 @@
 //! The runtime world the integrator traces: the placed stone, the floor, the lights and the
 //! material table, built once from a compiled [`Scene`].
 
+mod inside;
+mod lights;
+mod materials;
+
 pub use super::setup::{PROGRESS_AFTER, Setup, WorldError};
-use crate::bsdf::layered::ladder::AlbedoLadder;
-use crate::bsdf::{Bsdf, Bxdf, Lambert, LayeredBsdf};
+use crate::bsdf::{Bsdf, Lambert};
 use crate::color::Rgb;
 use crate::geometry::{MediumId, Ray, Stone, StoneHit};
 use crate::light::{Area, EnvironmentLight};
 use crate::medium::Medium;
 use crate::scene::{Effect, Scene};
-use crate::spectrum::RgbSample;
 use crate::texture::{Map, MapEffects};
-use glam::{Vec2, Vec3};
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use rayon::prelude::*;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::Instant;
+use glam::Vec3;
 
 /// What a ray hit first.
 #[derive(Clone, Copy, Debug)]
@@ -166,156 +164,9 @@ impl World {
                 .collect()
         });
         let stacks = prefiltered.as_deref().unwrap_or(&scene.surface.stacks);
-        // Tables take tens of milliseconds per material: build them in parallel (the result is
-        // the same in any order), at most one material per task, so a stop is noticed soon.
-        // Materials whose stacks are identical share one build (the first of them builds).
-        let mut seen: std::collections::HashMap<String, usize> = std::collections::HashMap::new();
-        let twin: Vec<usize> = (0..stacks.len())
-            .map(|k| {
-                if scene.surface.used[k] {
-                    let key = format!("{:?}", stacks[k]);
-                    *seen.entry(key).or_insert(k)
-                } else {
-                    k
-                }
-            })
-            .collect();
-        let distinct = seen.len() as u64;
-        let bar = ProgressBar::with_draw_target(Some(distinct), ProgressDrawTarget::hidden());
-        bar.set_style(
-            ProgressStyle::with_template(
-                "{spinner} [{elapsed_precise}] {wide_bar} {pos}/{len} material tables ETA {eta}",
-            )
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-        );
-        let start = Instant::now();
-        let shown = AtomicBool::new(false);
-        let built: Vec<Result<Option<(Bsdf, Rgb)>, WorldError>> = stacks
-            .par_iter()
-            .with_max_len(1)
-            .enumerate()
-            .map(|(k, desc)| {
-                if !scene.surface.used[k] || twin[k] != k {
-                    return Ok(None);
-                }
-                setup.check()?;
-                if setup.progress
-                    && start.elapsed() > PROGRESS_AFTER
-                    && !shown.swap(true, Ordering::Relaxed)
-                {
-                    // A terminal draw target draws nothing when standard error is not a terminal.
-                    bar.set_draw_target(ProgressDrawTarget::stderr());
-                }
-                bar.inc(1);
-                let material = |source| WorldError::Material {
-                    name: scene.surface.names[k].clone(),
-                    source,
-                };
-                let mut stack = LayeredBsdf::new(desc).map_err(material)?;
-                let absorption = scene.effects.forced(Effect::Absorption);
-                stack.force_absorption(absorption);
-                if scene.effects.on(Effect::Spectral)
-                    && let Some(l) = AlbedoLadder::build(desc, absorption).map_err(material)?
-                {
-                    stack.set_albedo_ladder(l);
-                }
-                let bsdf = Bsdf::from(stack);
-                let albedo = Rgb::from(normal_albedo(&bsdf));
-                Ok(Some((bsdf, albedo)))
-            })
-            .collect();
-        bar.finish_and_clear();
-        let mut materials: Vec<Option<Bsdf>> = Vec::with_capacity(built.len());
-        let mut albedo = Vec::with_capacity(built.len());
-        for (k, b) in built.into_iter().enumerate() {
-            match b? {
-                Some((bsdf, a)) => {
-                    materials.push(Some(bsdf));
-                    albedo.push(a);
-                }
-                // A used twin of an earlier material (built before it: `twin[k] < k`).
-                None if scene.surface.used[k] => {
-                    let first = twin[k];
-                    materials.push(materials[first].clone());
-                    albedo.push(albedo[first]);
-                }
-                None => {
-                    materials.push(None);
-                    albedo.push(Rgb::ZERO);
-                }
-            }
-        }
-        // The translucent body's boundary is material `body_index`, one past the stacks.
+        let (materials, albedo) = materials::build(scene, stacks, prefilter.as_ref(), setup)?;
         let body = scene.surface.body.as_ref();
         let shows_body = scene.effects.on(Effect::Transmission) && body.is_some();
-        if let Some(b) = body {
-            debug_assert_eq!(materials.len(), scene.surface.body_index() as usize);
-            materials.push(Some(b.boundary()));
-            // A lossless boundary: everything that arrives leaves, reflected or refracted.
-            albedo.push(Rgb::ONE);
-            // Platelet faces, under the body's IOR, from `body_index + 1`.
-            for (name, desc) in &b.platelet_materials {
-                setup.check()?;
-                let desc = match &prefilter {
-                    Some(p) => &super::prefilter::stack(p, desc),
-                    None => desc,
-                };
-                let mut stack = LayeredBsdf::new(desc).map_err(|source| WorldError::Material {
-                    name: format!("platelet:{name}"),
-                    source,
-                })?;
-                stack.force_absorption(scene.effects.forced(Effect::Absorption));
-                let bsdf = Bsdf::from(stack);
-                albedo.push(Rgb::from(normal_albedo(&bsdf)));
-                materials.push(Some(bsdf));
-            }
-        }
-        let scale = stage.to_world.matrix3.x_axis.length();
-        let medium_on = scene.effects.on(Effect::Medium);
-        let mut media = vec![if scene.effects.forced(Effect::Medium) == Some(true) {
-            // Forced on: the free-flight code runs on every segment, through a medium that
-            // neither absorbs nor scatters (its weight is exactly 1).
-            Medium::Homogeneous(crate::medium::Homogeneous {
-                sigma_a: Rgb::ZERO,
-                sigma_s: Rgb::ZERO,
-                phase: crate::medium::HenyeyGreenstein::new(0.0),
-                sigma_a_measured: None,
-                sigma_s_measured: None,
-            })
-        } else {
-            Medium::Vacuum
-        }];
-        if shows_body && let crate::geometry::Solid::Mesh(m) = stone.solid() {
-            let open = m.open_edges();
-            if open > 0 {
-                return Err(WorldError::OpenBody(open));
-            }
-            let volume = m.signed_volume();
-            if volume <= 0.0 {
-                return Err(WorldError::InsideOutBody(volume));
-            }
-        }
-        let interior = match body {
-            Some(b) if shows_body => {
-                media.push(if medium_on {
-                    b.medium(scale, stage.render.medium_scattering)
-                } else {
-                    Medium::Vacuum
-                });
-                MediumId(1)
-            }
-            _ => MediumId::OUTSIDE,
-        };
-        let transmission = scene.effects.on(Effect::Transmission);
-        let camera_medium = if transmission && interior != MediumId::OUTSIDE {
-            if stone.contains(stage.camera.from) {
-                interior
-            } else {
-                MediumId::OUTSIDE
-            }
-        } else {
-            MediumId::OUTSIDE
-        };
         // A translucent stone resting on the floor: light leaving through its base starts within
         // the spawn offset below the plane and would pass under the floor to the sky's nadir. The
         // floor is lowered by 10⁻⁴ of the stone's size there, so that light meets it and the
@@ -348,63 +199,8 @@ impl World {
             environment.set_importance(false);
         }
 
-        let (lo, hi) = stone.bounds();
-        let mut lo = lo;
-        let mut hi = hi;
-        for l in &stage.lights {
-            lo = lo.min(l.center);
-            hi = hi.max(l.center);
-        }
-        let centre = 0.5 * (lo + hi);
-        let radius = (0.5 * (hi - lo).length()).max(1e-3);
-
-        let mut power: Vec<f32> = areas.iter().map(Area::power).collect();
-        power.push(if environment.is_black() {
-            0.0
-        } else {
-            environment.power(radius)
-        });
-        let total: f32 = power.iter().filter(|p| p.is_finite()).sum();
-        let light_prob = power
-            .iter()
-            .map(|&p| {
-                if total > 0.0 && p.is_finite() {
-                    p / total
-                } else {
-                    0.0
-                }
-            })
-            .collect();
-
-        // The walks solve Snell's law with one index: a dispersive body in a spectral render
-        // refracts each wavelength its own way, so there light is found by BSDF sampling alone.
-        let dispersive =
-            scene.effects.on(Effect::Spectral) && body.is_some_and(|b| b.dispersion.is_some());
-        let manifold = match body {
-            Some(b) if shows_body && b.alpha == 0.0 && !dispersive => {
-                super::manifold::ManifoldSetup::new(
-                    b.ior,
-                    scene.surface.body_index(),
-                    &areas,
-                    scene.effects.on(Effect::ManifoldNee),
-                    scene.effects.on(Effect::ManifoldCaustics),
-                )
-            }
-            _ => None,
-        };
-        let platelets = match body {
-            Some(b)
-                if shows_body
-                    && scene.effects.on(Effect::Platelets)
-                    && stage.render.platelets_explicit =>
-            {
-                b.platelets.clone()
-            }
-            _ => vec![],
-        };
-        // Every walk inside the stone must fit the walk's cell budget.
-        let (object_lo, object_hi) = stone.solid().bounds();
-        crate::platelet::grid::check_span(&platelets, object_lo, object_hi)?;
+        let (light_prob, bounds) = lights::selection(&stone, &stage.lights, &areas, &environment);
+        let inside = inside::build(scene, &stone, &areas)?;
 
         Ok(World {
             stone,
@@ -414,28 +210,15 @@ impl World {
             light_prob,
             materials,
             albedo,
-            interior,
-            media,
-            camera_medium,
+            interior: inside.interior,
+            media: inside.media,
+            camera_medium: inside.camera_medium,
             medium_depth: stage.render.medium_depth,
             transmission_off: scene.effects.forced(Effect::Transmission) == Some(false),
-            platelets,
-            flakes: match body {
-                Some(b)
-                    if shows_body
-                        && scene.effects.on(Effect::Platelets)
-                        && !stage.render.platelets_explicit
-                        && !b.platelets.is_empty() =>
-                {
-                    Some(crate::platelet::statistical::FlakeMedium::new(
-                        &b.platelets,
-                        stage.to_world,
-                    ))
-                }
-                _ => None,
-            },
-            manifold,
-            medium: medium_on,
+            platelets: inside.platelets,
+            flakes: inside.flakes,
+            manifold: inside.manifold,
+            medium: scene.effects.on(Effect::Medium),
             map: scene.surface.map.with_effects(MapEffects {
                 overlay: scene.effects.forced(Effect::GlitterOverlay) != Some(false),
                 blend: scene.effects.forced(Effect::StochasticSwitch) != Some(false),
@@ -445,7 +228,7 @@ impl World {
             spectral: scene.effects.on(Effect::Spectral),
             fluorescence: scene.effects.on(Effect::Fluorescence),
             lines: stage.lights.iter().filter_map(|l| l.line).collect(),
-            bounds: (centre, radius),
+            bounds,
         })
     }
 
@@ -538,23 +321,6 @@ impl World {
             LightRef::Environment => self.light_prob[self.areas.len()],
         }
     }
-}
-
-/// Directional albedo at normal incidence, from a fixed stratified set of 256 samples (for the
-/// albedo AOV only).
-fn normal_albedo(bsdf: &Bsdf) -> RgbSample {
-    let n = 16;
-    let mut sum = RgbSample::ZERO;
-    for i in 0..n {
-        for j in 0..n {
-            let u = Vec2::new((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32);
-            let uc = ((i * n + j) as f32 + 0.5) / (n * n) as f32;
-            if let Some(s) = bsdf.sample(Vec3::Z, uc, u) {
-                sum += s.weight;
-            }
-        }
-    }
-    (sum * (1.0 / (n * n) as f32)).map(|v| v.clamp(0.0, 1.0))
 }
 
 #[cfg(test)]

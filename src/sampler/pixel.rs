@@ -68,8 +68,11 @@ impl PixelSampler {
         self.slot = self.slot.max(slot);
     }
 
+    /// The key of dimension slot `slot` of this pixel: with a sample index, it determines the
+    /// slot's pair ([`pair_of`]). The same for every sample of the pixel, so a renderer drawing
+    /// several samples of one pixel at once computes it once.
     #[inline]
-    fn key_of(&self, slot: u32) -> u64 {
+    pub fn key_of(&self, slot: u32) -> u64 {
         mix64(self.pixel_key ^ u64::from(slot).wrapping_mul(0x9e37_79b9_7f4a_7c15))
     }
 
@@ -104,17 +107,23 @@ impl PixelSampler {
     // spectral variant, stop 28) LLVM stopped inlining it, which cost RGB renders about 3 %.
     #[inline(always)]
     fn pair(&self, key: u64) -> Vec2 {
-        match self.kind {
-            SamplerKind::Independent => {
-                let a = mix64(key ^ u64::from(self.index));
-                let b = mix64(a ^ 0x2545_f491_4f6c_dd1d);
-                Vec2::new(to_unit_f32(a), to_unit_f32(b))
-            }
-            SamplerKind::Sobol => {
-                let seeds = [key as u32, (key >> 32) as u32, mix64(key) as u32];
-                let (x, y) = scrambled_pair(self.index, seeds);
-                Vec2::new(fixed_to_unit(x), fixed_to_unit(y))
-            }
+        pair_of(self.kind, key, self.index)
+    }
+}
+
+/// The pair of the slot with key `key` ([`PixelSampler::key_of`]) for sample `index`.
+#[inline(always)]
+pub fn pair_of(kind: SamplerKind, key: u64, index: u32) -> Vec2 {
+    match kind {
+        SamplerKind::Independent => {
+            let a = mix64(key ^ u64::from(index));
+            let b = mix64(a ^ 0x2545_f491_4f6c_dd1d);
+            Vec2::new(to_unit_f32(a), to_unit_f32(b))
+        }
+        SamplerKind::Sobol => {
+            let seeds = [key as u32, (key >> 32) as u32, mix64(key) as u32];
+            let (x, y) = scrambled_pair(index, seeds);
+            Vec2::new(fixed_to_unit(x), fixed_to_unit(y))
         }
     }
 }
