@@ -67,6 +67,12 @@ impl Stone {
         self.to_world
     }
 
+    /// The matrix carrying object normals to world normals (the inverse transpose of
+    /// `to_world`'s linear part).
+    pub fn normal_to_world(&self) -> Mat3A {
+        self.normal_to_world
+    }
+
     /// World → object transform.
     pub fn to_object(&self) -> Affine3A {
         self.to_object
@@ -91,7 +97,12 @@ impl Stone {
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<StoneHit> {
         let h = self.solid.intersect(&self.object_ray(ray), t_max)?;
         let ng = (self.normal_to_world * h.ng).normalize_or_zero();
-        let ns = (self.normal_to_world * h.ns).normalize_or(ng);
+        // An analytic shape's shading normal is its geometric one: transformed once.
+        let ns = if h.ns == h.ng {
+            ng
+        } else {
+            (self.normal_to_world * h.ns).normalize_or(ng)
+        };
         let p = self.to_world.transform_point3(h.p);
         (ng != Vec3::ZERO && p.is_finite()).then_some(StoneHit {
             t: h.t,

@@ -133,7 +133,7 @@ fn lane_row(
                 count: chunk.len() as u32,
                 sample: s,
             };
-            let out = lanes::dispatch(|| lanes::trace_packet(world, setup, packet));
+            let out = lanes::dispatch(world, setup, packet);
             for (p, o) in chunk.iter_mut().zip(&out) {
                 p.add(o);
             }

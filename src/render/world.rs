@@ -326,6 +326,7 @@ impl World {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bsdf::Bxdf;
     use crate::recipe::GemRecipe;
 
     #[test]

@@ -9,12 +9,15 @@
 //! why a scene needs the scalar loop instead).
 
 pub mod simd;
+mod stone;
 pub mod trace;
 
 pub use trace::trace_packet;
 
+use super::path::PathSample;
 use super::world::World;
 use crate::geometry::MediumId;
+use simd::L;
 
 /// Why `world` cannot be traced in lanes (`None`: it can): the scalar integrator's media,
 /// platelets, manifold walks, fluorescent lobes and wavelengths are not in the lane loop.
@@ -36,18 +39,28 @@ pub fn unsupported(world: &World) -> Option<&'static str> {
     }
 }
 
-/// Runs `f` compiled for the widest instruction set this machine has (AVX-512, AVX2 + FMA, or
-/// the x86-64 baseline), chosen at run time. `f` and everything it calls must be
-/// `#[inline(always)]` to be compiled that way.
-#[inline(always)]
-pub fn dispatch<R>(f: impl FnOnce() -> R) -> R {
-    struct Kernel<F>(F);
-    impl<R, F: FnOnce() -> R> pulp::WithSimd for Kernel<F> {
-        type Output = R;
+/// Traces `packet` with the kernel compiled for the widest instruction set this machine has
+/// (AVX-512, AVX2 + FMA, or the x86-64 baseline), chosen at run time by `pulp`. Everything the
+/// kernel calls is `#[inline(always)]` down to the lane operations ([`simd`]), so it is compiled
+/// for that instruction set too. (A closure handed to the dispatcher is not inlined into it:
+/// the kernel is this named type's method.)
+#[inline]
+pub fn dispatch(world: &World, setup: &trace::Setup, packet: trace::Packet) -> [PathSample; L] {
+    struct Kernel<'a> {
+        world: &'a World,
+        setup: &'a trace::Setup<'a>,
+        packet: trace::Packet,
+    }
+    impl pulp::WithSimd for Kernel<'_> {
+        type Output = [PathSample; L];
         #[inline(always)]
-        fn with_simd<S: pulp::Simd>(self, _: S) -> R {
-            (self.0)()
+        fn with_simd<S: pulp::Simd>(self, _: S) -> [PathSample; L] {
+            trace_packet(self.world, self.setup, self.packet)
         }
     }
-    pulp::Arch::new().dispatch(Kernel(f))
+    pulp::Arch::new().dispatch(Kernel {
+        world,
+        setup,
+        packet,
+    })
 }

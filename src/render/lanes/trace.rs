@@ -3,13 +3,15 @@
 //! ([`crate::render::integrator::trace_at`]) for an opaque RGB scene in the same order on its own
 //! numbers, so each lane's sample is bit for bit the scalar one.
 
-use super::simd::{L, M, V3};
+use super::simd::{F, L, M, V3};
+use crate::bsdf::power_heuristic;
 use crate::geometry::{MediumId, Ray, offset_origin};
+use crate::light::LightSample;
 use crate::render::camera::CameraRays;
-use crate::render::direct::{Strategy, direct_light, emission_weight};
+use crate::render::direct::{Strategy, emission_weight};
 use crate::render::filter::FilterSampler;
 use crate::render::path::{PathSample, PathState};
-use crate::render::shading::shade;
+use crate::render::shading::{SurfaceBsdf, shade};
 use crate::render::world::{Hit, LightRef, World};
 use crate::sampler::{PixelSampler, SamplerKind, slots};
 use crate::spectrum::{RgbSample, RgbWavelengths, Spectral};
@@ -79,24 +81,53 @@ pub fn trace_packet(world: &World, setup: &Setup, packet: Packet) -> [PathSample
     let mut alive = live;
     while alive.any() {
         // Phase 1: intersect.
-        let mut found: [Option<Hit>; L] = [None; L];
         for i in alive.lanes() {
             samplers[i].skip_to(slots::bounce(paths[i].depth));
             out[i].rays += 1;
-            found[i] = world.intersect(&Ray::new(origin.at(i), dir.at(i)), f32::INFINITY);
         }
-        // Phases 2–6, lane by lane.
+        let found = intersect(world, alive, origin, dir);
+        // Phases 2–4, lane by lane: emission, shading, the light sample and its BSDF value.
+        let mut vertices: [Option<Vertex>; L] = [None; L];
+        let mut shadow_o = V3::splat(glam::Vec3::ZERO);
+        let mut shadow_d = V3::splat(glam::Vec3::ZERO);
+        let mut shadow_t = F::splat(0.0);
+        let mut shadowed = M::splat(false);
         for i in alive.lanes() {
-            let next = bounce(
+            let ray = Ray::new(origin.at(i), dir.at(i));
+            vertices[i] = vertex(
                 world,
                 setup,
                 &mut samplers[i],
                 &mut paths[i],
                 &mut out[i],
-                Ray::new(origin.at(i), dir.at(i)),
+                ray,
                 found[i],
             );
-            match next {
+            match &vertices[i] {
+                None => alive.0[i] = false,
+                Some(v) => {
+                    if let Some(n) = &v.nee {
+                        out[i].rays += 1;
+                        shadow_o.set(i, n.ray.origin);
+                        shadow_d.set(i, n.ray.dir);
+                        shadow_t.0[i] = n.t_max;
+                        shadowed.0[i] = true;
+                    }
+                }
+            }
+        }
+        // Phase 5: the shadow rays.
+        let occluded = occluded(world, shadowed, shadow_o, shadow_d, shadow_t);
+        // Phase 6, lane by lane: the light sample's contribution, the BSDF sample, Russian
+        // roulette and the next ray.
+        for i in alive.lanes() {
+            let v = vertices[i].as_ref().expect("a live lane has a vertex");
+            if let Some(n) = &v.nee
+                && !occluded.0[i]
+            {
+                gather(world, setup.strategy, v, n, &mut paths[i]);
+            }
+            match continue_path(world, v, &mut samplers[i], &mut paths[i]) {
                 Some(r) => {
                     origin.set(i, r.origin);
                     dir.set(i, r.dir);
@@ -111,19 +142,97 @@ pub fn trace_packet(world: &World, setup: &Setup, packet: Packet) -> [PathSample
     out
 }
 
-/// One bounce of one lane after its intersection: emission, shading, next-event estimation, the
-/// BSDF sample and Russian roulette (the scalar integrator's steps for an opaque RGB scene). The
-/// next ray, or `None` when the path ends.
+/// The first hit of each live lane's ray (unit direction) within `(0, ∞)`: the stone, the floor,
+/// then the area lights, each closer than the last (as [`World::intersect`]).
 #[inline(always)]
-fn bounce(
-    world: &World,
+fn intersect(world: &World, live: M, o: V3, d: V3) -> [Option<Hit>; L] {
+    let (hit, stone) = super::stone::intersect(&world.stone, live, o, d);
+    let mut t_best = F::from_fn(|i| if hit.0[i] { stone[i].t } else { f32::INFINITY });
+    let mut kind = [0u8; L]; // 0 nothing, 1 stone, 2 floor, 3 light
+    for i in hit.lanes() {
+        kind[i] = 1;
+    }
+    let mut ground_t = F::splat(0.0);
+    if let Some((h, _)) = world.ground {
+        let t = (h - o.y) / d.y;
+        let closer = t.gt(F::splat(0.0)) & t.lt(t_best) & live;
+        t_best = F::select(closer, t, t_best);
+        ground_t = t;
+        for i in closer.lanes() {
+            kind[i] = 2;
+        }
+    }
+    let mut light = [0usize; L];
+    for (index, a) in world.areas.iter().enumerate() {
+        for i in live.lanes() {
+            if let Some(t) = a.intersect(&Ray::new(o.at(i), d.at(i)), t_best.at(i)) {
+                t_best.0[i] = t;
+                kind[i] = 3;
+                light[i] = index;
+            }
+        }
+    }
+    std::array::from_fn(|i| match kind[i] {
+        1 => Some(Hit::Stone(stone[i])),
+        2 => {
+            let t = ground_t.at(i);
+            Some(Hit::Ground {
+                t,
+                p: Ray::new(o.at(i), d.at(i)).at(t),
+            })
+        }
+        3 => Some(Hit::Light {
+            index: light[i],
+            t: t_best.at(i),
+        }),
+        _ => None,
+    })
+}
+
+/// A lane's surface vertex between the phases of a bounce.
+#[derive(Clone, Copy)]
+struct Vertex<'a> {
+    /// The BSDF at the hit.
+    sb: SurfaceBsdf<'a>,
+    /// `wo` in its shading frame.
+    wo_local: glam::Vec3,
+    /// Whether next-event estimation ran here (a light was looked for).
+    looked: bool,
+    /// The light sample waiting for its shadow ray.
+    nee: Option<LightPath>,
+}
+
+/// A light sample whose contribution waits for its shadow ray (the scalar `direct_light`, split
+/// at the shadow test).
+#[derive(Clone, Copy)]
+struct LightPath {
+    /// The shadow ray and its extent.
+    ray: Ray,
+    t_max: f32,
+    /// The chosen light.
+    light: LightRef,
+    /// Probability of the light times the sample's density.
+    p_light: f32,
+    /// The sample.
+    sample: LightSample,
+    /// `wi` in the shading frame and `f(wo, wi)`.
+    wi_local: glam::Vec3,
+    f: RgbSample,
+}
+
+/// One lane's bounce up to the shadow test: emission of a miss or a light (the path then ends:
+/// `None`), shading, the depth limit, the light sample and its BSDF value (the scalar
+/// integrator's steps for an opaque RGB scene, in its order).
+#[inline(always)]
+fn vertex<'a>(
+    world: &'a World,
     setup: &Setup,
     sampler: &mut PixelSampler,
     path: &mut PathState<RgbSample>,
     out: &mut PathSample,
     ray: Ray,
     found: Option<Hit>,
-) -> Option<Ray> {
+) -> Option<Vertex<'a>> {
     let strategy = setup.strategy;
     let hit = match found {
         None => {
@@ -161,19 +270,106 @@ fn bounce(
     let wo_local = sb.frame.to_local(wo);
     let u_light = sampler.get1d();
     let u_point = sampler.get2d();
-    let nee = strategy != Strategy::BsdfOnly && !sb.flags().is_specular_only();
-    if nee {
-        direct_light(world, strategy, &sb, wo_local, u_light, u_point, path, out);
+    let looked = strategy != Strategy::BsdfOnly && !sb.flags().is_specular_only();
+    let nee = if looked {
+        light_path(world, &sb, wo_local, u_light, u_point)
+    } else {
+        None
+    };
+    Some(Vertex {
+        sb,
+        wo_local,
+        looked,
+        nee,
+    })
+}
+
+/// The scalar `direct_light` up to its shadow test: a light picked and sampled, the sample
+/// admitted by the surface, its BSDF value non-zero, and the shadow ray.
+#[inline(always)]
+fn light_path(
+    world: &World,
+    sb: &SurfaceBsdf,
+    wo_local: glam::Vec3,
+    u_light: f32,
+    u_point: Vec2,
+) -> Option<LightPath> {
+    let (light, p_pick) = world.pick_light(u_light)?;
+    let sample = match light {
+        LightRef::Area(i) => world.areas[i].sample(sb.p, u_point),
+        LightRef::Environment => world.environment.sample(u_point),
+    }?;
+    if !sb.admits(sample.wi) || (world.transmission_off && sample.wi.dot(sb.ng) < 0.0) {
+        return None;
     }
+    let (wi_local, f) = sb.eval::<RgbSample>(wo_local, sample.wi, &RgbWavelengths);
+    if f.is_black() {
+        return None;
+    }
+    let origin = offset_origin(sb.p, sb.ng, sample.wi);
+    let t_max = if sample.dist.is_finite() {
+        (sample.dist - (origin - sb.p).length()) * (1.0 - 1e-4)
+    } else {
+        f32::INFINITY
+    };
+    Some(LightPath {
+        ray: Ray::new(origin, sample.wi),
+        t_max,
+        light,
+        p_light: p_pick * sample.pdf,
+        sample,
+        wi_local,
+        f,
+    })
+}
+
+/// The rest of `direct_light` for an unoccluded light sample: its MIS weight and contribution.
+#[inline(always)]
+fn gather(
+    world: &World,
+    strategy: Strategy,
+    v: &Vertex,
+    n: &LightPath,
+    path: &mut PathState<RgbSample>,
+) {
+    let w = match strategy {
+        Strategy::Mis => power_heuristic(
+            n.p_light,
+            v.sb.pdf::<RgbSample>(v.wo_local, n.wi_local, &RgbWavelengths),
+        ),
+        _ => 1.0,
+    };
+    let radiance = match n.light {
+        LightRef::Area(i) => {
+            world.areas[i].emission::<RgbSample>(n.sample.radiance, &RgbWavelengths)
+        }
+        LightRef::Environment => RgbSample::from_illuminant(n.sample.radiance, &RgbWavelengths),
+    };
+    let c = path.throughput() * n.f * radiance * (n.wi_local.z.abs() * w / n.p_light);
+    if c.is_valid() {
+        path.gather(c);
+    }
+}
+
+/// The BSDF sample, Russian roulette and the next ray of a lane (`None`: the path ends).
+#[inline(always)]
+fn continue_path(
+    world: &World,
+    v: &Vertex,
+    sampler: &mut PixelSampler,
+    path: &mut PathState<RgbSample>,
+) -> Option<Ray> {
     let uc = sampler.get1d();
     let u = sampler.get2d();
-    let bs = sb.sample::<RgbSample>(wo_local, uc, u, &path.lambda)?;
+    let bs = v.sb.sample::<RgbSample>(v.wo_local, uc, u, &path.lambda)?;
     if world.transmission_off && bs.flags.is_transmission() {
         return None;
     }
-    path.scatter(&bs, sb.p, sb.inside);
-    if !nee && let Some(v) = path.prev.as_mut() {
-        v.nee = false;
+    path.scatter(&bs, v.sb.p, v.sb.inside);
+    if !v.looked
+        && let Some(prev) = path.prev.as_mut()
+    {
+        prev.nee = false;
     }
     if path.depth >= RR_DEPTH {
         let q = path.survival();
@@ -185,6 +381,37 @@ fn bounce(
     if !path.alive() {
         return None;
     }
-    let origin = offset_origin(sb.p, sb.ng, bs.wi);
+    let origin = offset_origin(v.sb.p, v.sb.ng, bs.wi);
     Some(Ray::in_medium(origin, bs.wi, path.medium))
+}
+
+/// Whether anything blocks each shadowed lane's ray before its `t_max` (as [`World::occluded`]:
+/// the floor, the area lights, the stone).
+#[inline(always)]
+fn occluded(world: &World, live: M, o: V3, d: V3, t_max: F) -> M {
+    let mut blocked = M::splat(false);
+    if let Some((h, _)) = world.ground {
+        let t = (h - o.y) / d.y;
+        blocked = t.gt(F::splat(0.0)) & t.lt(t_max);
+    }
+    let mut open = live.and_not(blocked);
+    for a in &world.areas {
+        for i in open.lanes() {
+            if a.intersect(&Ray::new(o.at(i), d.at(i)), t_max.at(i))
+                .is_some()
+            {
+                blocked.0[i] = true;
+            }
+        }
+        open = live.and_not(blocked);
+    }
+    for i in open.lanes() {
+        if world
+            .stone
+            .occluded(&Ray::new(o.at(i), d.at(i)), t_max.at(i))
+        {
+            blocked.0[i] = true;
+        }
+    }
+    blocked & live
 }
