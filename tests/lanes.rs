@@ -129,3 +129,21 @@ fn scenes_the_lanes_do_not_trace_say_why() {
         assert!(said.contains(why), "{gem}: {said}");
     }
 }
+
+#[test]
+fn info_and_the_world_agree_on_the_loop() {
+    for entry in std::fs::read_dir(root().join("gems")).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_none_or(|e| e != "ron") {
+            continue;
+        }
+        let s = scene(&path);
+        let world = World::new(&s).unwrap();
+        assert_eq!(
+            lanes::scalar_because(&s.effects).is_none(),
+            lanes::unsupported(&world).is_none(),
+            "{}",
+            path.display()
+        );
+    }
+}

@@ -366,6 +366,19 @@ pub fn describe(recipe: &GemRecipe, scene: &Scene, points: u32) -> String {
         );
     }
 
+    // The path loop (docs/design.md §13).
+    let _ = writeln!(
+        o,
+        "\npath loop: {}",
+        match crate::render::lanes::scalar_because(&scene.effects) {
+            None => format!(
+                "lanes ({} paths per packet, in SIMD registers; `--lanes off`: scalar)",
+                crate::render::lanes::simd::L
+            ),
+            Some(why) => format!("scalar ({why} is not in the lane loop)"),
+        }
+    );
+
     // Effects.
     let _ = writeln!(o, "\neffects:");
     for e in Effect::ALL {

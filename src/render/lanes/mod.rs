@@ -39,6 +39,25 @@ pub fn unsupported(world: &World) -> Option<&'static str> {
     }
 }
 
+/// Why a scene whose effects are `effects` is traced by the scalar loop (`None`: by lanes), from
+/// the effects alone (what `lapidary info` prints before any world is built; it agrees with
+/// [`unsupported`] on the built world).
+pub fn scalar_because(effects: &crate::scene::Effects) -> Option<&'static str> {
+    use crate::scene::Effect;
+    [
+        (Effect::Spectral, "spectral transport"),
+        (Effect::Transmission, "a translucent body (transmission)"),
+        (Effect::Medium, "a participating medium"),
+        (Effect::Platelets, "platelets"),
+        (Effect::ManifoldNee, "manifold next-event estimation"),
+        (Effect::ManifoldCaustics, "manifold next-event estimation"),
+        (Effect::Fluorescence, "fluorescence"),
+    ]
+    .into_iter()
+    .find(|(e, _)| effects.on(*e))
+    .map(|(_, why)| why)
+}
+
 /// Traces `packet` with the kernel compiled for the widest instruction set this machine has
 /// (AVX-512, AVX2 + FMA, or the x86-64 baseline), chosen at run time by `pulp`. Everything the
 /// kernel calls is `#[inline(always)]` down to the lane operations ([`simd`]), so it is compiled
