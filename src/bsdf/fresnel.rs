@@ -100,7 +100,7 @@ pub fn lazanyi(cos_i: f32, n: f32, k: f32) -> f32 {
 
 /// How a material evaluates Fresnel reflectance (course §3.4.1). Never chosen silently: the default
 /// is `Exact`, the rest exist for the accuracy-versus-time study.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub enum FresnelMode {
     /// The exact equations.
     #[default]

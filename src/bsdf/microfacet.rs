@@ -23,8 +23,10 @@
 //!
 //! Near-mirror roughness (m = 0.01°, `e ≈ 6.6e7`) is handled by never forming `cos θh` from a
 //! difference: `cos^e θh = exp(e/2 · ln(1 − sin²θh))` with `sin²θh = hx² + hy²`, and the samplers
-//! invert their CDFs with `expm1`/`ln_1p` (docs/design.md §5.3).
+//! invert their CDFs with `expm1`/`ln_1p` (docs/design.md §5.3). Blinn's exponent and its
+//! sampler run in `f64` through the inline kernels of [`super::fastmath`] (accurate to ~1e-14).
 
+use super::fastmath;
 pub use super::masking::{Masking, v_cavity_g, v_cavity_g1};
 use super::masking::{lambda_beckmann, lambda_ggx};
 use glam::{Vec2, Vec3};
@@ -127,12 +129,14 @@ impl MicrofacetDistribution {
                 // ln cos θh from the tangential part near the normal (where 1 − z² cancels) and
                 // from z near the horizon (where sin² θh rounds to 1 in f32 although cos θh > 0:
                 // D is not 0 there for e ≤ 0, and both argument orders of a pair must agree).
+                // In f64 by the inline kernels of [`super::fastmath`]: `1 − s2` is exact there
+                // for every `s2` that matters, and one rounding to f32 at the end.
                 let log_cos = if s2 < 0.5 {
-                    0.5 * (-s2).ln_1p()
+                    0.5 * fastmath::ln(1.0 - f64::from(s2))
                 } else {
-                    h.z.ln()
+                    fastmath::ln(f64::from(h.z))
                 };
-                (e + 2.0) / (2.0 * PI) * (e * log_cos).exp()
+                (e + 2.0) / (2.0 * PI) * fastmath::exp(f64::from(e) * log_cos) as f32
             }
             Ndf::Beckmann => {
                 let c2 = if s2 < 0.5 { 1.0 - s2 } else { h.z * h.z };
@@ -164,7 +168,8 @@ impl MicrofacetDistribution {
         let s2 = match self.ndf {
             Ndf::Blinn { exponent: e } => {
                 // CDF of cos θh: 1 − cos^(e+2) θh = u  ⇒  sin²θh = 1 − (1−u)^(2/(e+2)).
-                -((2.0 / (e + 2.0)) * (-u0).ln_1p()).exp_m1()
+                let c = 2.0 / (f64::from(e) + 2.0) * fastmath::ln_1p(-f64::from(u0));
+                -fastmath::exp_m1(c) as f32
             }
             Ndf::Beckmann => {
                 // tan²θh = −α² ln(1 − u).
@@ -302,6 +307,30 @@ impl MicrofacetDistribution {
     /// Smith with Beckmann or Blinn; `wo` is mirrored above the surface when it lies below.
     #[inline]
     pub fn pdf_visible(&self, wo: Vec3, h: Vec3) -> f32 {
+        self.pdf_visible_with_d(wo, h, self.d(h))
+    }
+
+    /// `pdf_visible(wo, h) / D(h)`: what a sample weight `f cos / pdf` keeps of the density
+    /// once `D` cancels (`G1 ⟨wo·h⟩ / |cos θo|`, or `cos θh` for Smith with Beckmann or Blinn);
+    /// 0 where the density is 0.
+    #[inline]
+    pub fn visible_over_d(&self, wo: Vec3, h: Vec3) -> f32 {
+        let w = if wo.z < 0.0 { -wo } else { wo };
+        let wh = w.dot(h);
+        if w.z <= 0.0 || wh <= 0.0 {
+            return 0.0;
+        }
+        match (self.masking, self.ndf) {
+            (Masking::VCavity, _) => v_cavity_g1(w, h) * (wh / w.z),
+            (_, Ndf::Ggx) => self.g1(w, h) * (wh / w.z),
+            _ => h.z.max(0.0),
+        }
+    }
+
+    /// [`Self::pdf_visible`] with `d = self.d(h)` already evaluated (a caller that needs both `f`
+    /// and the density evaluates `D` once); the same result bit for bit.
+    #[inline]
+    pub fn pdf_visible_with_d(&self, wo: Vec3, h: Vec3, d: f32) -> f32 {
         let w = if wo.z < 0.0 { -wo } else { wo };
         let wh = w.dot(h);
         if w.z <= 0.0 || wh <= 0.0 {
@@ -310,9 +339,9 @@ impl MicrofacetDistribution {
         let p = match (self.masking, self.ndf) {
             // (wh / w.z) first: with D deep in the subnormal range a product with a small cosine
             // would underflow to 0 while f (divided by cosines) is still positive.
-            (Masking::VCavity, _) => v_cavity_g1(w, h) * self.d(h) * (wh / w.z),
-            (_, Ndf::Ggx) => self.g1(w, h) * self.d(h) * (wh / w.z),
-            _ => self.pdf_h(h),
+            (Masking::VCavity, _) => v_cavity_g1(w, h) * d * (wh / w.z),
+            (_, Ndf::Ggx) => self.g1(w, h) * d * (wh / w.z),
+            _ => d * h.z.max(0.0),
         };
         if p.is_finite() { p } else { 0.0 }
     }

@@ -25,6 +25,7 @@
 
 pub mod dielectric;
 pub mod dispersion;
+pub mod fastmath;
 pub mod fresnel;
 pub mod interface_energy;
 pub mod lambert;

@@ -4,10 +4,14 @@
 //! intersections and unions of intervals rather than by testing each surface patch separately
 //! and accepting points inside its boundary. There is no acceptance test at the rim to fail by
 //! rounding, so rays aimed at the rim cannot slip between the dome and the base.
+//!
+//! Each ellipsoid is met in its normalised frame, where it is the unit sphere: the ray is scaled
+//! by the reciprocal semi-axes (stored with the shape, so a query multiplies rather than
+//! divides), and the unit sphere's interval needs one square root (the discriminant's) — its
+//! terms are compared squared, never as lengths.
 
 use super::hit::{GeometryError, ShapeHit, first_of_interval, valid_query};
 use super::ray::Ray;
-use super::sphere::sphere_interval;
 use glam::Vec3;
 
 /// A cabochon in object space: the dome `x²/rx² + y²/h² + z²/rz² ≤ 1, y ≥ 0` over the flat base
@@ -19,42 +23,92 @@ pub struct Cabochon {
     upper: Vec3,
     /// Semi-axes of the lower dome (rx, base, rz); `base` is 0 for a flat base.
     lower: Vec3,
+    /// `1 / upper`, object units⁻¹: object space to the upper dome's normalised frame.
+    inv_upper: Vec3,
+    /// `1 / lower` (its `y` infinite, and unused, for a flat base), object units⁻¹.
+    inv_lower: Vec3,
+    /// `h / base`: the upper frame's `y` to the lower frame's (0 for a flat base).
+    lower_y: f32,
 }
 
-/// `t` range of the half-space `y ≥ 0` (`up`) or `y ≤ 0` along `o + t·d`, as `(lo, hi)` with
-/// `NaN`-free infinities; `None` if the line runs parallel outside it.
-#[inline]
+/// Which surface a hit lies on, with the point of the normalised frame its position and normal
+/// follow from.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum Piece {
+    /// The flat base, at the upper frame's point `q` (its `y` is 0 up to rounding).
+    Base(Vec3),
+    /// The upper dome, at the point `u` of the unit sphere of its frame.
+    Upper(Vec3),
+    /// The lower dome, at the point `u` of the unit sphere of its frame.
+    Lower(Vec3),
+}
+
+/// The part of a query that depends on its origin alone: the origin in the upper dome's
+/// normalised frame and `|o|² − 1` in the upper and the lower frame (the constant term of each
+/// unit sphere's quadratic). A fan of rays from one point shares it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct FrameOrigin {
+    o: Vec3,
+    c_upper: f32,
+    c_lower: f32,
+}
+
+/// The parameters `t0 ≤ t1` where the line `o + t·d` crosses the unit sphere centred at the
+/// origin (`t` in units of `d`; `c = |o|² − 1`), or `None` if it misses (or only touches at
+/// `t = 0`).
+///
+/// The sphere's `sphere_interval` at radius 1, with the same two precision measures (the
+/// discriminant from the point `l` of the line closest to the centre, `a·(1 − |l|²)`, and the
+/// stable roots `c/q`, `q/a`), but `1 − |l|²` and `c` from squared lengths: at radius 1 they are
+/// as exact as the factored forms `(1 − |l|)(1 + |l|)` (both carry an absolute error of a few
+/// ulps of 1), without the two square roots.
+#[inline(always)]
+fn unit_sphere_interval(o: Vec3, c: f32, d: Vec3) -> Option<(f32, f32)> {
+    let a = d.length_squared();
+    let inv_a = a.recip();
+    let b = o.dot(d);
+    let disc = 1.0 - (o - d * (b * inv_a)).length_squared();
+    if !(disc >= 0.0) {
+        return None;
+    }
+    let q = -(b + (a * disc).sqrt().copysign(b));
+    if q == 0.0 {
+        return None;
+    }
+    let (t0, t1) = (c / q, q * inv_a);
+    if !(t0.is_finite() && t1.is_finite()) {
+        return None;
+    }
+    Some((t0.min(t1), t0.max(t1)))
+}
+
+/// `t` range of the half-space `y ≥ 0` (`up`) or `y ≤ 0` along `o + t·d` (`oy`, `dy` its `y`
+/// components), as `(lo, hi)` with `NaN`-free infinities; `None` if the line runs parallel
+/// outside it.
+#[inline(always)]
 fn half_space(oy: f32, dy: f32, up: bool) -> Option<(f32, f32)> {
-    let s = if up { 1.0 } else { -1.0 };
-    if dy == 0.0 {
-        return (s * oy >= 0.0).then_some((f32::NEG_INFINITY, f32::INFINITY));
-    }
-    let tp = -oy / dy;
-    if s * dy > 0.0 {
-        Some((tp, f32::INFINITY))
+    let (oy, dy) = if up { (oy, dy) } else { (-oy, -dy) };
+    if dy > 0.0 {
+        Some((-oy / dy, f32::INFINITY))
+    } else if dy < 0.0 {
+        Some((f32::NEG_INFINITY, -oy / dy))
     } else {
-        Some((f32::NEG_INFINITY, tp))
+        (oy >= 0.0).then_some((f32::NEG_INFINITY, f32::INFINITY))
     }
 }
 
-/// The interval of `o + t·d` inside the ellipsoid of semi-axes `axes` (in the space scaled to a
-/// unit sphere, where `t` is unchanged), intersected with the upper or lower half-space. The
-/// flags tell whether each end is on the plane `y = 0` rather than on the ellipsoid.
-#[inline]
-fn half_ellipsoid(o: Vec3, d: Vec3, axes: Vec3, up: bool) -> Option<(f32, f32, bool, bool)> {
-    let (e0, e1) = sphere_interval(o / axes, d / axes, 1.0)?;
+/// The interval of the line inside an ellipsoid, given in the ellipsoid's normalised frame (the
+/// origin `o` with `c = |o|² − 1`, the direction `d`; scaling leaves `t` unchanged), intersected
+/// with the upper or lower half-space (its bound is the same in the frame: `y` is scaled by a
+/// positive factor). The flags tell whether each end is on the plane `y = 0` rather than on the
+/// ellipsoid.
+#[inline(always)]
+fn half_ellipsoid(o: Vec3, c: f32, d: Vec3, up: bool) -> Option<(f32, f32, bool, bool)> {
+    let (e0, e1) = unit_sphere_interval(o, c, d)?;
     let (h0, h1) = half_space(o.y, d.y, up)?;
     let (t_in, in_plane) = if h0 > e0 { (h0, true) } else { (e0, false) };
     let (t_out, out_plane) = if h1 < e1 { (h1, true) } else { (e1, false) };
     (t_in <= t_out).then_some((t_in, t_out, in_plane, out_plane))
-}
-
-/// `p` projected radially (in the space where the ellipsoid of semi-axes `axes` is a unit sphere)
-/// onto that ellipsoid, and the unit outward normal there (the gradient `(x/a², y/b², z/c²)`).
-#[inline]
-fn on_ellipsoid(p: Vec3, axes: Vec3) -> (Vec3, Vec3) {
-    let u = (p / axes).normalize_or(Vec3::Y);
-    (u * axes, (u / axes).normalize_or(Vec3::Y))
 }
 
 impl Cabochon {
@@ -71,9 +125,13 @@ impl Cabochon {
                 ),
             });
         }
+        let (upper, lower) = (Vec3::new(rx, h, rz), Vec3::new(rx, base, rz));
         Ok(Cabochon {
-            upper: Vec3::new(rx, h, rz),
-            lower: Vec3::new(rx, base, rz),
+            upper,
+            lower,
+            inv_upper: upper.recip(),
+            inv_lower: lower.recip(),
+            lower_y: if base == 0.0 { 0.0 } else { h / base },
         })
     }
 
@@ -82,45 +140,115 @@ impl Cabochon {
         self.lower.y == 0.0
     }
 
-    /// Closest hit with `0 < t < t_max` (object space, `t` in units of `ray.dir`).
-    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<ShapeHit> {
-        if !valid_query(ray, t_max) {
-            return None;
+    /// `1 / axes()`: object space to the domes' normalised frames, object units⁻¹ (the lower
+    /// `y` is infinite for a flat base).
+    pub(crate) fn inv_axes(&self) -> (Vec3, Vec3) {
+        (self.inv_upper, self.inv_lower)
+    }
+
+    /// A vector of the upper dome's normalised frame in the lower dome's.
+    #[inline(always)]
+    fn lower_frame(&self, v: Vec3) -> Vec3 {
+        Vec3::new(v.x, v.y * self.lower_y, v.z)
+    }
+
+    /// The origin-only part of a query whose origin is `o` in the upper dome's normalised frame.
+    #[inline(always)]
+    pub(crate) fn frame_origin(&self, o: Vec3) -> FrameOrigin {
+        let c_lower = if self.flat_base() {
+            0.0
+        } else {
+            self.lower_frame(o).length_squared() - 1.0
+        };
+        FrameOrigin {
+            o,
+            c_upper: o.length_squared() - 1.0,
+            c_lower,
         }
-        let (o, d) = (ray.origin, ray.dir);
+    }
+
+    /// The solid's interval along the ray from `org` along `d` (the upper frame's direction),
+    /// `(t_in, t_out)`, and for a flat base whether each end lies on the base.
+    #[inline(always)]
+    fn span(&self, org: &FrameOrigin, d: Vec3) -> Option<(f32, f32, bool, bool)> {
+        let o = org.o;
         if self.flat_base() {
             // Convex: ellipsoid ∩ {y ≥ 0}; the plane ends are the base disc.
-            let (t_in, t_out, in_plane, out_plane) = half_ellipsoid(o, d, self.upper, true)?;
-            let (t, exit) = first_of_interval(t_in, t_out, t_max)?;
-            if if exit { out_plane } else { in_plane } {
-                let p = ray.at(t);
-                let p = Vec3::new(p.x, 0.0, p.z);
-                return Some(ShapeHit {
-                    t,
-                    ng: Vec3::NEG_Y,
-                    ns: Vec3::NEG_Y,
-                    p,
-                });
-            }
-            let (mut p, n) = on_ellipsoid(ray.at(t), self.upper);
-            p.y = p.y.max(0.0);
-            return Some(ShapeHit { t, ng: n, ns: n, p });
+            return half_ellipsoid(o, org.c_upper, d, true);
         }
         // Domed base: the union of the two half-ellipsoids, convex because they share the
         // equator and the surface normal is continuous across it. The union of the two pieces'
         // intervals is the solid's interval; an end on the plane y = 0 can only survive the
         // union at the rim (a rounding tie), where both ellipsoids and their normals agree.
-        let up = half_ellipsoid(o, d, self.upper, true);
-        let down = half_ellipsoid(o, d, self.lower, false);
-        let (t_in, t_out) = match (up, down) {
-            (Some(a), Some(b)) => (a.0.min(b.0), a.1.max(b.1)),
-            (Some(a), None) | (None, Some(a)) => (a.0, a.1),
-            (None, None) => return None,
+        let up = half_ellipsoid(o, org.c_upper, d, true);
+        let down = half_ellipsoid(self.lower_frame(o), org.c_lower, self.lower_frame(d), false);
+        match (up, down) {
+            (Some(a), Some(b)) => Some((a.0.min(b.0), a.1.max(b.1), false, false)),
+            (Some(a), None) | (None, Some(a)) => Some((a.0, a.1, false, false)),
+            (None, None) => None,
+        }
+    }
+
+    /// Whether the ray from `org` along the upper frame's direction `d` meets the solid with
+    /// `0 < t < t_max`: exactly when [`Cabochon::first_hit`] finds a hit.
+    #[inline(always)]
+    pub(crate) fn meets(&self, org: &FrameOrigin, d: Vec3, t_max: f32) -> bool {
+        self.span(org, d)
+            .and_then(|(t_in, t_out, ..)| first_of_interval(t_in, t_out, t_max))
+            .is_some()
+    }
+
+    /// The closest hit with `0 < t < t_max` of the ray from `org` along the upper frame's
+    /// direction `d`: its `t` and the piece of surface with its normalised-frame point.
+    #[inline(always)]
+    pub(crate) fn first_hit(&self, org: &FrameOrigin, d: Vec3, t_max: f32) -> Option<(f32, Piece)> {
+        let (t_in, t_out, in_plane, out_plane) = self.span(org, d)?;
+        let (t, exit) = first_of_interval(t_in, t_out, t_max)?;
+        let q = org.o + d * t;
+        let piece = if if exit { out_plane } else { in_plane } {
+            Piece::Base(q)
+        } else if q.y >= 0.0 || self.flat_base() {
+            Piece::Upper(q.normalize_or(Vec3::Y))
+        } else {
+            let ql = self.lower_frame(org.o) + self.lower_frame(d) * t;
+            Piece::Lower(ql.normalize_or(Vec3::Y))
         };
-        let (t, _) = first_of_interval(t_in, t_out, t_max)?;
-        let q = ray.at(t);
-        let (p, n) = on_ellipsoid(q, if q.y >= 0.0 { self.upper } else { self.lower });
-        Some(ShapeHit { t, ng: n, ns: n, p })
+        Some((t, piece))
+    }
+
+    /// The object-space point of a hit's piece (on the surface to rounding).
+    #[inline(always)]
+    pub(crate) fn point(&self, piece: Piece) -> Vec3 {
+        match piece {
+            Piece::Base(q) => Vec3::new(q.x * self.upper.x, 0.0, q.z * self.upper.z),
+            Piece::Upper(u) => {
+                let p = u * self.upper;
+                Vec3::new(p.x, p.y.max(0.0), p.z)
+            }
+            Piece::Lower(u) => u * self.lower,
+        }
+    }
+
+    /// Closest hit with `0 < t < t_max` (object space, `t` in units of `ray.dir`).
+    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<ShapeHit> {
+        if !valid_query(ray, t_max) {
+            return None;
+        }
+        let org = self.frame_origin(ray.origin * self.inv_upper);
+        let (t, piece) = self.first_hit(&org, ray.dir * self.inv_upper, t_max)?;
+        // The outward normal is the gradient `(x/a², y/b², z/c²)`: the unit-sphere point
+        // scaled by the reciprocal semi-axes.
+        let n = match piece {
+            Piece::Base(_) => Vec3::NEG_Y,
+            Piece::Upper(u) => (u * self.inv_upper).normalize_or(Vec3::Y),
+            Piece::Lower(u) => (u * self.inv_lower).normalize_or(Vec3::Y),
+        };
+        Some(ShapeHit {
+            t,
+            ng: n,
+            ns: n,
+            p: self.point(piece),
+        })
     }
 
     /// Object-space bounds `(min, max)`.

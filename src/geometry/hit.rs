@@ -73,7 +73,18 @@ pub enum GeometryError {
 /// direction and `t_max > 0` (infinite allowed, NaN not).
 #[inline]
 pub(crate) fn valid_query(ray: &Ray, t_max: f32) -> bool {
-    ray.origin.is_finite() && ray.dir.is_finite() && ray.dir != Vec3::ZERO && t_max > 0.0
+    // `x · 0` is ±0 for a finite `x` and NaN for an infinite or NaN one, and the NaN survives
+    // the sum: one test for all six components.
+    let z = ray.origin * 0.0 + ray.dir * 0.0;
+    z.x + z.y + z.z == 0.0 && ray.dir != Vec3::ZERO && t_max > 0.0
+}
+
+/// [`valid_query`] for a ray whose origin is known to be finite: a finite, non-zero `dir` and
+/// `t_max > 0`.
+#[inline]
+pub(crate) fn valid_direction(dir: Vec3, t_max: f32) -> bool {
+    let z = dir * 0.0;
+    z.x + z.y + z.z == 0.0 && dir != Vec3::ZERO && t_max > 0.0
 }
 
 /// The first parameter of a ray/convex-solid interval `[t_in, t_out]` inside `(0, t_max)`, with

@@ -5,9 +5,11 @@
 //! ([`Solid`]); a [`Stone`] places one in the world.
 
 pub mod cabochon;
+pub mod fan;
 pub mod frame;
 pub mod hit;
 pub mod mesh;
+pub mod placed;
 pub mod ray;
 pub mod shape;
 pub mod slab;
@@ -16,6 +18,7 @@ pub mod sphere;
 pub mod stone;
 
 pub use cabochon::Cabochon;
+pub use fan::Fan;
 pub use frame::Frame;
 pub use hit::{GeometryError, ShapeHit};
 pub use mesh::Mesh;

@@ -1,7 +1,7 @@
 //! The stone: its solid placed in the world by an affine transform.
 
 use super::hit::GeometryError;
-use super::ray::Ray;
+use super::placed::{PlacedCabochon, placed};
 use super::shape::Shape;
 use super::solid::Solid;
 use glam::{Affine3A, Mat3A, Vec3};
@@ -29,6 +29,9 @@ pub struct Stone {
     to_world: Affine3A,
     to_object: Affine3A,
     normal_to_world: Mat3A,
+    /// A cabochon met in its world-placed normalised frames (module `fan`); `None` for the
+    /// other solids.
+    placed: Option<PlacedCabochon>,
 }
 
 impl Stone {
@@ -50,6 +53,7 @@ impl Stone {
         }
         let normal_to_world = to_object.matrix3.transpose();
         Ok(Stone {
+            placed: placed(&solid, to_object, normal_to_world),
             solid,
             to_world,
             to_object,
@@ -78,65 +82,9 @@ impl Stone {
         self.to_object
     }
 
-    /// The world ray in object space. The direction is not renormalised, so object-space `t`
-    /// equals world-space `t`.
-    #[inline]
-    fn object_ray(&self, ray: &Ray) -> Ray {
-        Ray::new(
-            self.to_object.transform_point3(ray.origin),
-            self.to_object.transform_vector3(ray.dir),
-        )
-    }
-
-    /// Closest hit with `0 < t < t_max` along a world ray (unit direction, so `t` is a distance).
-    ///
-    /// The world point is `to_world(p_object)`, with `p_object` projected onto the surface in
-    /// object space, rather than `ray.at(t)`: its error is then a few ulps of the coordinates
-    /// wherever the ray came from, while `ray.at(t)` carries the error of `t`, which grows with
-    /// the distance the ray travelled (a far camera) and puts the point off the surface.
-    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<StoneHit> {
-        let h = self.solid.intersect(&self.object_ray(ray), t_max)?;
-        let ng = (self.normal_to_world * h.ng).normalize_or_zero();
-        // An analytic shape's shading normal is its geometric one: transformed once.
-        let ns = if h.ns == h.ng {
-            ng
-        } else {
-            (self.normal_to_world * h.ns).normalize_or(ng)
-        };
-        let p = self.to_world.transform_point3(h.p);
-        (ng != Vec3::ZERO && p.is_finite()).then_some(StoneHit {
-            t: h.t,
-            p,
-            p_object: h.p,
-            ng,
-            ns,
-        })
-    }
-
-    /// Whether world point `p` lies inside the stone: the first surface a ray from `p` meets is
-    /// seen from its back (the surface's own normals point outward on a closed, consistently
-    /// wound stone). Tried along three fixed directions; the majority decides, so a ray grazing an
-    /// edge cannot flip the answer alone.
-    pub fn contains(&self, p: Vec3) -> bool {
-        let dirs = [
-            Vec3::new(0.267, 0.534, 0.802),
-            Vec3::new(-0.577, -0.211, 0.789),
-            Vec3::new(0.123, -0.911, -0.394),
-        ];
-        let inside = dirs
-            .iter()
-            .filter(|d| {
-                let d = d.normalize();
-                self.intersect(&Ray::new(p, d), f32::INFINITY)
-                    .is_some_and(|h| h.ng.dot(d) > 0.0)
-            })
-            .count();
-        inside >= 2
-    }
-
-    /// Whether the stone blocks the world ray anywhere in `0 < t < t_max`.
-    pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
-        self.solid.occluded(&self.object_ray(ray), t_max)
+    /// The placed cabochon, if the solid is one.
+    pub(crate) fn placed(&self) -> Option<&PlacedCabochon> {
+        self.placed.as_ref()
     }
 
     /// World-space axis-aligned bounds `(min, max)` of the transformed object bounds (Arvo,
@@ -156,6 +104,7 @@ impl Stone {
 mod tests {
     use super::*;
     use crate::geometry::mesh::Mesh;
+    use crate::geometry::ray::Ray;
     use crate::geometry::solid::test_util::{random_ray, test_mesh};
     use crate::sampler::Rng;
     use glam::Quat;

@@ -23,11 +23,15 @@
 //! Density: uniform, or modulated by a field over object space ([`modulation`]): the platelets are
 //! generated at the full density and thinned, each kept with probability `m(centre)`.
 
+mod block;
+mod discs;
 pub mod grid;
 pub mod modulation;
 pub mod statistical;
+pub mod table;
 
 pub use modulation::Modulation;
+pub use table::Prepared;
 
 use crate::sampler::{Rng, hash_words};
 use glam::Vec3;
@@ -73,6 +77,9 @@ pub struct Population {
     /// The density's modulation, a factor in `[0, 1]` at each point; `None`: uniform density
     /// (the generation is then exactly that of an unmodulated population).
     pub modulation: Option<Modulation>,
+    /// The platelets of the stone's cells drawn once for the grid walk ([`Population::prepare`],
+    /// [`table`]): a cache, ignored by equality and by a copy whose seed, cell or radii differ.
+    pub table: Prepared,
 }
 
 /// One platelet: a disc.
@@ -138,6 +145,7 @@ impl Population {
                 cell,
                 mean_per_cell,
                 modulation: None,
+                table: Prepared::default(),
             },
         )
     }
@@ -146,6 +154,14 @@ impl Population {
     /// each platelet's centre; the grid and every platelet's attributes stay those of `self`.
     pub fn with_modulation(self, modulation: Option<Modulation>) -> Population {
         Population { modulation, ..self }
+    }
+
+    /// Draws the platelets of every cell the walks inside the object-space box `[lo, hi]` (the
+    /// stone's bounds) can visit, once, for the grid walk to read ([`table`]); none if the box
+    /// needs more than [`table::MAX_CELLS`] cells or [`table::MAX_DISCS`] discs. No result
+    /// changes: the walk reads the numbers it would otherwise draw.
+    pub fn prepare(&mut self, lo: Vec3, hi: Vec3) {
+        table::prepare(self, lo, hi);
     }
 
     /// The platelets of cell `c` that survive thinning, in a fixed order (a pure function of the
@@ -225,8 +241,37 @@ impl Population {
     }
 }
 
+impl Population {
+    /// A platelet's unit normal and material index, drawn from its cell's stream positioned after
+    /// its centre ([`CellStream::finish`]).
+    #[inline]
+    pub fn finish_disc(&self, rng: &mut Rng) -> (Vec3, u32) {
+        let normal = self.orientation.sample(rng.uniform(), rng.uniform());
+        let material = pick_entry(&self.entries, rng.uniform());
+        (normal, material)
+    }
+}
+
 /// Numbers a platelet draws after its radius and centre: two for the normal, one for the entry.
 const DRAWS_AFTER_CENTRE: u64 = 3;
+
+/// A platelet's radius, drawn from its cell's stream only when asked for.
+#[derive(Clone, Debug)]
+pub struct LazyRadius {
+    /// The stream positioned at the radius's number.
+    rng: Rng,
+    /// The population's smallest and largest radius.
+    range: (f32, f32),
+}
+
+impl LazyRadius {
+    /// The radius, object units.
+    #[inline]
+    pub fn draw(mut self) -> f32 {
+        let (r0, r1) = self.range;
+        r0 + (r1 - r0) * self.rng.uniform()
+    }
+}
 
 /// One cell's platelets, drawn in order from the cell's stream ([`Population::stream`]).
 #[derive(Clone, Debug)]
@@ -248,14 +293,26 @@ impl CellStream<'_> {
     /// the last. Its normal and material follow from [`CellStream::finish`], or are skipped.
     #[inline]
     pub fn next_disc(&mut self) -> Option<(u32, Vec3, f32)> {
+        self.next_centre()
+            .map(|(index, center, radius)| (index, center, radius.draw()))
+    }
+
+    /// [`CellStream::next_disc`] with the radius left undrawn until asked for (the grid walk's
+    /// first bounding-sphere test takes the largest radius): the same numbers.
+    #[inline]
+    pub fn next_centre(&mut self) -> Option<(u32, Vec3, LazyRadius)> {
         if std::mem::take(&mut self.pending) {
             self.rng.skip(DRAWS_AFTER_CENTRE);
         }
         if self.next >= self.count {
             return None;
         }
-        let (r0, r1) = self.pop.radius;
-        let radius = r0 + (r1 - r0) * self.rng.uniform();
+        // The stream is counter-based: the radius is the next number, the centre the three after.
+        let radius = LazyRadius {
+            rng: self.rng.clone(),
+            range: self.pop.radius,
+        };
+        self.rng.skip(1);
         let (x, y, z) = (self.rng.uniform(), self.rng.uniform(), self.rng.uniform());
         let center = self.origin + Vec3::new(x, y, z) * self.pop.cell;
         let index = self.next;
@@ -271,12 +328,14 @@ impl CellStream<'_> {
         if !std::mem::take(&mut self.pending) {
             return None;
         }
-        let normal = self
-            .pop
-            .orientation
-            .sample(self.rng.uniform(), self.rng.uniform());
-        let material = pick_entry(&self.pop.entries, self.rng.uniform());
-        Some((normal, material))
+        Some(self.pop.finish_disc(&mut self.rng))
+    }
+
+    /// The stream positioned at the normal of the platelet [`CellStream::next_disc`] just gave
+    /// (what [`CellStream::finish`] draws from, for [`Population::finish_disc`]).
+    #[inline]
+    pub fn rest(&self) -> Rng {
+        self.rng.clone()
     }
 }
 

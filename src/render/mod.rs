@@ -232,7 +232,7 @@ where
     // The lane loop where it applies (docs/design.md §13): the same samples, bit for bit.
     let lane_setup =
         (S::WAVELENGTH_DIMENSIONS == 0 && !control.scalar && lanes::unsupported(world).is_none())
-            .then(|| lanes::trace::Setup {
+            .then_some(lanes::trace::Setup {
                 rays: &rays,
                 filter: &filter,
                 sampler: settings.sampler,

@@ -484,6 +484,12 @@ type Events = [Option<(Vec3, RgbSample)>; 2];
 /// few thousand choices would be off by several per cent).
 #[inline]
 fn sample_interface(iface: &CoatInterface, wo: Vec3, uc: f32, u: Vec2) -> Events {
+    if !iface.smooth {
+        return iface
+            .rough
+            .sample_split(wo, uc, u, TransportMode::Radiance)
+            .map(|e| e.map(|(wi, w)| (wi, RgbSample::splat(w))));
+    }
     [Lobes::Reflection, Lobes::Transmission].map(|lobes| {
         iface
             .sample_lobes(wo, uc, u, TransportMode::Radiance, lobes)

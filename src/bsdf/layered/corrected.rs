@@ -22,6 +22,7 @@
 //! Jacobian `cos θi / (η² cos θi')`.
 
 use super::{LayeredBsdf, absorption, course};
+use crate::bsdf::memo::Memo;
 use crate::bsdf::table::{Table, for_strata};
 use crate::bsdf::{
     Bsdf, BsdfSample, Bxdf, Lobe, LobeKind, refract_macro, sample_cosine_hemisphere,
@@ -30,6 +31,7 @@ use crate::sampler::hash_words;
 use crate::spectrum::RgbSample;
 use glam::{Vec2, Vec3};
 use std::f32::consts::{FRAC_1_PI, PI};
+use std::sync::Arc;
 
 /// `f(wo, wi)` of the Corrected model at stack level `l` (`l == coats` = the base): the top lobe
 /// plus the body, the body of the outermost level scaled by the stack's albedo calibration
@@ -324,6 +326,17 @@ pub fn sample(
     BsdfSample::from_eval(wi, f, pdf(stack, l, wo, wi, corrected), lobe)
 }
 
+/// Key of a coat's top-lobe albedo table: distribution, masking, `α` bits; relative IOR bits and
+/// Fresnel mode; level and sampling grid (the level seeds the table's numbers).
+type ETopKey = (
+    (crate::bsdf::Distribution, crate::bsdf::Masking, u32),
+    (u32, crate::bsdf::FresnelMode),
+    (usize, usize),
+);
+
+/// Top-lobe albedo tables shared by the materials of a process (see [`crate::bsdf::memo`]).
+static E_TOP: Memo<ETopKey, Arc<Table>> = Memo::new(4096);
+
 /// Builds the tables of level `l` (the levels below must be built already): `E_top`, then `A` and
 /// `Q` by stratified Monte Carlo over the Corrected sampling of the layers below, then `ρ̄`, `r_int`
 /// and the multiple lobe's constants.
@@ -333,14 +346,26 @@ pub(super) fn build_tables(stack: &mut LayeredBsdf, l: usize, grid: usize) {
     stack.levels[l].e_top = if stack.levels[l].smooth {
         // A delta reflection's albedo is the Fresnel factor itself.
         let fresnel = stack.levels[l].fresnel.clone();
-        Table::build(|mu| RgbSample::splat(fresnel.eval(mu)[0]))
+        Table::build(|mu| RgbSample::splat(fresnel.eval(mu)[0])).map(|e| e.min(1.0))
     } else {
-        Table::by_sampling(grid, hash_words(&[l as u64, 1]), |wo, uc, u| {
-            top.sample(wo, uc, u)
-                .map_or(RgbSample::ZERO, |s| s.weight.map(|w| w.min(1e3)))
-        })
-    }
-    .map(|e| e.min(1.0));
+        // Shared by every material with this coat at this level (a gem's materials often repeat
+        // their varnish): the table depends on nothing else.
+        let d = top.distribution;
+        let key = (
+            (d.kind(), d.masking(), d.alpha().to_bits()),
+            (stack.levels[l].eta.to_bits(), stack.fresnel),
+            (l, grid),
+        );
+        let table = E_TOP.get_or_build(key, || {
+            Arc::new(
+                Table::by_sampling(grid, hash_words(&[l as u64, 1]), |wo, uc, u| {
+                    top.sample_weight(wo, uc, u).map(|w| w.min(1e3))
+                })
+                .map(|e| e.min(1.0)),
+            )
+        });
+        Table::clone(&table)
+    };
 
     let (eta, od) = (stack.levels[l].eta, stack.levels[l].od);
     let this = &*stack;

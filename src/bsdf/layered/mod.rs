@@ -332,9 +332,30 @@ const SMOOTH_PLACEHOLDER: f32 = 0.01;
 const TABLE_GRID: usize = 16;
 
 impl LayeredBsdf {
-    /// Validates `desc` and builds its runtime tables (a few milliseconds per coat).
+    /// Validates `desc` and builds its runtime tables (tens of milliseconds per material).
     pub fn new(desc: &StackDesc) -> Result<Self, StackError> {
         validate(desc)?;
+        Ok(Self::build_tables_of(desc))
+    }
+
+    /// Builds the tables of a valid `desc`.
+    fn build_tables_of(desc: &StackDesc) -> Self {
+        let mut stack = Self::skeleton(desc);
+        if let Bsdf::TorranceSparrow(ts) = &mut stack.base
+            && desc.compensation
+        {
+            *ts = ts.clone().with_compensation();
+        }
+        for l in (0..stack.levels.len()).rev() {
+            corrected::build_tables(&mut stack, l, TABLE_GRID);
+        }
+        stack.prepare_model();
+        stack
+    }
+
+    /// The stack of a valid `desc` with every table still empty: its levels, its base without
+    /// compensation, its knobs.
+    fn skeleton(desc: &StackDesc) -> Self {
         let mut above = desc.outside_ior;
         let mut levels = Vec::with_capacity(desc.coats.len());
         for c in &desc.coats {
@@ -400,14 +421,8 @@ impl LayeredBsdf {
             }
         };
         let base_plain = base.clone();
-        let base = match base {
-            Bsdf::TorranceSparrow(ts) if desc.compensation => {
-                Bsdf::TorranceSparrow(ts.with_compensation())
-            }
-            b => b,
-        };
         let t_term = desc.t_term;
-        let mut stack = LayeredBsdf {
+        LayeredBsdf {
             levels: levels.into_boxed_slice(),
             base,
             base_plain,
@@ -428,12 +443,7 @@ impl LayeredBsdf {
                 _ => None,
             },
             ladder: None,
-        };
-        for l in (0..stack.levels.len()).rev() {
-            corrected::build_tables(&mut stack, l, TABLE_GRID);
         }
-        stack.prepare_model();
-        Ok(stack)
     }
 
     /// Builds what the current model needs beyond the shared tables: the albedo calibration of

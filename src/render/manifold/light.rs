@@ -206,7 +206,7 @@ pub fn walk_probability(world: &World, x0: Vec3, x2: Vec3, chain: Chain) -> f32 
         return 1.0;
     };
     // The straight line's segment inside the body (η = 1: no bending).
-    let Some((h, _, _)) = last(world, x0, d, 1.0, chain) else {
+    let Some((h, _, _)) = last(world, &world.stone.fan(x0), d, 1.0, chain) else {
         return 1.0;
     };
     let mut tau = if world.medium {

@@ -2,7 +2,7 @@
 //! connection it finds (module docs in [`super`]).
 
 use crate::bsdf::refract;
-use crate::geometry::{Frame, Ray, StoneHit, offset_origin};
+use crate::geometry::{Fan, Frame, StoneHit, offset_origin};
 use crate::render::world::World;
 use glam::{Vec2, Vec3};
 
@@ -90,10 +90,10 @@ pub struct Connection {
     pub jacobian: f32,
 }
 
-/// The refraction into the body along `(x0, d)` from outside; `None` if the ray misses the body
-/// or does not enter it there.
-fn entry(world: &World, x0: Vec3, d: Vec3, eta: f32) -> Option<Entry> {
-    let h = world.stone.intersect(&Ray::new(x0, d), f32::INFINITY)?;
+/// The refraction into the body along direction `d` of the rays `from` the vertex outside; `None`
+/// if the ray misses the body or does not enter it there.
+fn entry(from: &Fan, d: Vec3, eta: f32) -> Option<Entry> {
+    let h = from.intersect(d, f32::INFINITY)?;
     let c = -h.ns.dot(d);
     if !(h.ng.dot(d) < 0.0 && c > 0.0) {
         return None;
@@ -112,21 +112,22 @@ fn entry(world: &World, x0: Vec3, d: Vec3, eta: f32) -> Option<Entry> {
     })
 }
 
-/// The chain's last boundary point along `(x0, d)` (where it leaves the body), the direction
-/// arriving there from inside, and the entry point of a [`Chain::Through`].
+/// The chain's last boundary point along direction `d` of the rays `from` the vertex (where it
+/// leaves the body), the direction arriving there from inside, and the entry point of a
+/// [`Chain::Through`].
 #[inline]
 pub(super) fn last(
     world: &World,
-    x0: Vec3,
+    from: &Fan,
     d: Vec3,
     eta: f32,
     chain: Chain,
 ) -> Option<(StoneHit, Vec3, Option<Entry>)> {
     match chain {
-        Chain::Out => boundary(world, x0, d).map(|(h, _)| (h, d, None)),
+        Chain::Out => boundary(from, d).map(|(h, _)| (h, d, None)),
         Chain::Through => {
-            let e = entry(world, x0, d, eta)?;
-            boundary(world, e.origin, e.inside).map(|(h, _)| (h, e.inside, Some(e)))
+            let e = entry(from, d, eta)?;
+            boundary(&world.stone.fan(e.origin), e.inside).map(|(h, _)| (h, e.inside, Some(e)))
         }
     }
 }
@@ -137,7 +138,12 @@ pub(super) fn last(
 /// # Arguments
 /// * `eta` – IOR inside over outside.
 pub fn exit(world: &World, x0: Vec3, d: Vec3, eta: f32, chain: Chain) -> Option<Exit> {
-    let (h, inside, entry) = last(world, x0, d, eta, chain)?;
+    exit_from(world, &world.stone.fan(x0), d, eta, chain)
+}
+
+/// [`exit`] along direction `d` of the rays `from` the vertex.
+fn exit_from(world: &World, from: &Fan, d: Vec3, eta: f32, chain: Chain) -> Option<Exit> {
+    let (h, inside, entry) = last(world, from, d, eta, chain)?;
     // `refract` takes the direction away from the surface on the incident side.
     let out = refract(-inside, h.ns, eta)?;
     Some(Exit {
@@ -152,11 +158,11 @@ pub fn exit(world: &World, x0: Vec3, d: Vec3, eta: f32, chain: Chain) -> Option<
     })
 }
 
-/// The boundary point the ray `(x0, d)` leaves the stone through, and `cos` of `d` with its
-/// shading normal (> 0).
+/// The boundary point the ray along direction `d` of the rays `from` a point inside leaves the
+/// stone through, and `cos` of `d` with its shading normal (> 0).
 #[inline]
-pub(super) fn boundary(world: &World, x0: Vec3, d: Vec3) -> Option<(StoneHit, f32)> {
-    let h = world.stone.intersect(&Ray::new(x0, d), f32::INFINITY)?;
+pub(super) fn boundary(from: &Fan, d: Vec3) -> Option<(StoneHit, f32)> {
+    let h = from.intersect(d, f32::INFINITY)?;
     let c = h.ns.dot(d);
     (h.ng.dot(d) > 0.0 && c > 0.0).then_some((h, c))
 }
@@ -166,7 +172,8 @@ pub(super) fn boundary(world: &World, x0: Vec3, d: Vec3) -> Option<(StoneHit, f3
 #[derive(Clone, Copy)]
 struct Problem<'a> {
     world: &'a World,
-    x0: Vec3,
+    /// The stone's rays from `x0` (every step of the walk casts one).
+    from: Fan<'a>,
     x2: Vec3,
     eta: f32,
     chain: Chain,
@@ -181,7 +188,7 @@ impl Problem<'_> {
     /// traced).
     #[inline]
     fn constraint(&self, d: Vec3) -> Option<(Vec3, StoneHit)> {
-        let (h, w, _) = last(self.world, self.x0, d, self.eta, self.chain)?;
+        let (h, w, _) = last(self.world, &self.from, d, self.eta, self.chain)?;
         let u = (self.x2 - h.p).try_normalize()?;
         let v = self.eta * w - u;
         Some((v - h.ns * v.dot(h.ns), h))
@@ -345,7 +352,7 @@ pub fn solve(
     let seed = (x2 - x0).try_normalize()?;
     let problem = Problem {
         world,
-        x0,
+        from: world.stone.fan(x0),
         x2,
         eta,
         chain,
@@ -370,7 +377,7 @@ pub fn solve(
             d
         }
     };
-    let e = exit(world, x0, d, eta, chain)?;
+    let e = exit_from(world, &problem.from, d, eta, chain)?;
     let to_light = x2 - e.p;
     let dist = to_light.length();
     // Snell's law holds and the refracted ray really heads for the light.

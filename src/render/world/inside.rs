@@ -86,13 +86,13 @@ pub(super) fn build(scene: &Scene, stone: &Stone, areas: &[Area]) -> Result<Insi
         Some(b) if shows_body && b.alpha == 0.0 && !dispersive => ManifoldSetup::new(
             b.ior,
             scene.surface.body_index(),
-            &areas,
+            areas,
             scene.effects.on(Effect::ManifoldNee),
             scene.effects.on(Effect::ManifoldCaustics),
         ),
         _ => None,
     };
-    let platelets = match body {
+    let mut platelets = match body {
         Some(b)
             if shows_body
                 && scene.effects.on(Effect::Platelets)
@@ -105,6 +105,10 @@ pub(super) fn build(scene: &Scene, stone: &Stone, areas: &[Area]) -> Result<Insi
     // Every walk inside the stone must fit the walk's cell budget.
     let (object_lo, object_hi) = stone.solid().bounds();
     crate::platelet::grid::check_span(&platelets, object_lo, object_hi)?;
+    // The cells around the stone drawn once for the walks (no result changes; bounded).
+    for p in &mut platelets {
+        p.prepare(object_lo, object_hi);
+    }
 
     let flakes = match body {
         Some(b)
