@@ -30,12 +30,12 @@ fn same_both_ways(name: &str, scene: &Scene, control: Control) {
         None,
         "{name}: expected the lane loop to apply"
     );
-    let lanes = fingerprint(&world, scene, &control);
-    let scalar = fingerprint(
+    let scalar = fingerprint(&world, scene, &control);
+    let lanes = fingerprint(
         &world,
         scene,
         &Control {
-            scalar: true,
+            lanes: true,
             ..control
         },
     );

@@ -372,7 +372,8 @@ pub fn describe(recipe: &GemRecipe, scene: &Scene, points: u32) -> String {
         "\npath loop: {}",
         match crate::render::lanes::scalar_because(&scene.effects) {
             None => format!(
-                "lanes ({} paths per packet, in SIMD registers; `--lanes off`: scalar)",
+                "scalar (`--lanes on`: {} paths per packet in SIMD registers, the same image; \
+                 not yet faster)",
                 crate::render::lanes::simd::L
             ),
             Some(why) => format!("scalar ({why} is not in the lane loop)"),

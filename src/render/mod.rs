@@ -80,9 +80,10 @@ pub struct Control<'a> {
     /// into the one-machine render bit for bit. An empty or out-of-range end is clamped to
     /// `spp`.
     pub samples: Option<std::ops::Range<u32>>,
-    /// Trace with the scalar path loop even where the lane loop applies ([`lanes`]; both give the
-    /// same image bit for bit: `--lanes off`, for comparisons).
-    pub scalar: bool,
+    /// Trace with the lane loop where it applies ([`lanes`]; both loops give the same image bit
+    /// for bit). Off by default: the lane loop is not faster yet (docs/design.md §13 has the
+    /// figures); `--lanes on`.
+    pub lanes: bool,
 }
 
 /// Figures of a finished (or stopped) render.
@@ -231,7 +232,7 @@ where
     };
     // The lane loop where it applies (docs/design.md §13): the same samples, bit for bit.
     let lane_setup =
-        (S::WAVELENGTH_DIMENSIONS == 0 && !control.scalar && lanes::unsupported(world).is_none())
+        (S::WAVELENGTH_DIMENSIONS == 0 && control.lanes && lanes::unsupported(world).is_none())
             .then_some(lanes::trace::Setup {
                 rays: &rays,
                 filter: &filter,
