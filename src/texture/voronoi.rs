@@ -121,7 +121,7 @@ impl Voronoi {
         let (lo, hi) = (local * local, (DVec3::ONE - local) * (DVec3::ONE - local));
         let mut d1 = f64::INFINITY;
         let (mut c1, mut id1) = (bc, 0u64);
-        for o in NEIGHBOURS {
+        for &o in &NEIGHBOURS {
             if box_distance_sq(o, lo, hi) >= d1 {
                 continue;
             }
@@ -180,7 +180,7 @@ impl Voronoi {
             }
         };
         let (lo, hi) = (local * local, (DVec3::ONE - local) * (DVec3::ONE - local));
-        for o in NEIGHBOURS {
+        for &o in &NEIGHBOURS {
             // A cell whose box is farther than F2 cannot change F1 or F2.
             if box_distance_sq(o, lo, hi) < best.4 {
                 consider(&mut best, o);
@@ -213,7 +213,7 @@ impl Voronoi {
         };
         // The 3×3×3 block nearest first, culling boxes that cannot hold a point closer than
         // f1 + 2·edge; then whole shells while one can.
-        for o in NEIGHBOURS {
+        for &o in &NEIGHBOURS {
             if box_distance_sq(o, lo, hi) < (f1 + 2.0 * edge).powi(2) {
                 bisector(o, &mut edge);
             }
@@ -376,6 +376,55 @@ mod tests {
                 s.edge
             );
             assert!(s.f1 <= s.f2 && s.edge >= 0.0);
+        }
+    }
+
+    /// The culling by box distances changes nothing: F1, its cell and id, and
+    /// F2 equal an exhaustive scan of the 9×9×9 block, bit for bit, at 20 000 points per jitter
+    /// (some on cell faces and lattice points).
+    #[test]
+    fn lookups_equal_an_exhaustive_scan() {
+        for jitter in [0.0, 0.3, 1.0] {
+            let v = Voronoi::new(7, jitter);
+            let mut rng = Rng::new(17);
+            for i in 0..20_000 {
+                let mut p = (Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) - 0.5) * 40.0;
+                if i % 10 == 0 {
+                    p = p.round();
+                } else if i % 10 == 1 {
+                    p.x = p.x.round();
+                }
+                let q = clamp_input(p);
+                let base = q.floor();
+                let local = q - base;
+                let bc = IVec3::new(base.x as i32, base.y as i32, base.z as i32);
+                let (mut d1, mut d2, mut best) = (f64::INFINITY, f64::INFINITY, (bc, 0));
+                let mut tie = false;
+                for x in -4..=4 {
+                    for y in -4..=4 {
+                        for z in -4..=4 {
+                            let o = IVec3::new(x, y, z);
+                            let id = v.cell_id(bc + o);
+                            let d = (o.as_dvec3() + v.offset(id) - local).length_squared();
+                            if d < d1 {
+                                (d2, d1, best, tie) = (d1, d, (bc + o, id), false);
+                            } else if d < d2 {
+                                d2 = d;
+                                tie |= d == d1;
+                            } else {
+                                tie |= d == d1;
+                            }
+                        }
+                    }
+                }
+                let (n, s) = (v.nearest(p), v.sample(p));
+                assert_eq!(n.f1, d1.sqrt() as f32, "{p:?}");
+                // Equidistant feature points (jitter 0 on lattice points): either may win.
+                if !tie {
+                    assert_eq!((n.cell, n.id), best, "{p:?}");
+                }
+                assert_eq!(s.f2, d2.sqrt() as f32, "{p:?}");
+            }
         }
     }
 
