@@ -466,11 +466,13 @@ mod tests {
         ];
         let mut rng = crate::sampler::Rng::new(29);
         for base in bases {
-            let stack = LayeredBsdf::new(&StackDesc::new(vec![], base.clone())).unwrap();
+            let stack = LayeredBsdf::new(&StackDesc::new(vec![], base)).unwrap();
             let mut some = 0;
             for _ in 0..20_000 {
-                let wo =
-                    crate::bsdf::spherical_direction(rng.uniform() * 1.5707, rng.uniform() * 6.3);
+                let wo = crate::bsdf::spherical_direction(
+                    rng.uniform() * std::f32::consts::FRAC_PI_2,
+                    rng.uniform() * 6.3,
+                );
                 let (uc, u) = (rng.uniform(), rng.uniform2());
                 let fast = sample(&stack, 0, wo, uc, u, true);
                 let general = sample_general(&stack, 0, wo, uc, u, true);
