@@ -325,7 +325,12 @@ mod tests {
         for unprepared in [plain, thinned] {
             let mut prepared = unprepared.clone();
             prepared.prepare(Vec3::splat(-0.5), Vec3::splat(0.5));
-            assert!(prepared.table.for_population(&prepared).is_some());
+            assert!(
+                prepared
+                    .table
+                    .for_population(&prepared)
+                    .is_some_and(|t| !t.is_empty())
+            );
             let mut rng = Rng::new(23);
             let mut hits = 0;
             for _ in 0..4000 {

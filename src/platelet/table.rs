@@ -124,11 +124,6 @@ impl CellTable {
         self.key == key(pop)
     }
 
-    /// Number of cells listed, of places in their lists and of discs drawn.
-    pub fn len(&self) -> (usize, usize, usize) {
-        (self.start.len() - 1, 4 * self.quads.len(), self.drawn.len())
-    }
-
     /// Whether the table lists no cell.
     pub fn is_empty(&self) -> bool {
         self.start.len() <= 1
