@@ -103,6 +103,24 @@ pub(super) fn manifold_weight(strategy: Strategy, p_walk: f32, p_bsdf: f32, walk
     }
 }
 
+/// [`emission_weight`] of area light `index` met at distance `t` along `ray`.
+#[inline]
+pub(super) fn area_emission_weight<S: Spectral>(
+    world: &World,
+    strategy: Strategy,
+    path: &PathState<S>,
+    ray: &Ray,
+    (index, t): (usize, f32),
+) -> f32 {
+    emission_weight(world, strategy, path, || {
+        let origin = path.prev.map_or(ray.origin, |v| v.p);
+        (
+            LightRef::Area(index),
+            world.areas[index].pdf(origin, ray.dir, t),
+        )
+    })
+}
+
 /// MIS weight of emission reached by the path's current ray (weight 1 for a camera ray, after a
 /// specular event, which light sampling cannot reproduce, and after a vertex where no light was
 /// sampled — a medium point or a reflecting surface inside the stone). `light_pdf` gives the

@@ -61,7 +61,9 @@
 //!
 //! **Sample dimensions.** The slot layout is [`crate::sampler`]'s (written once there).
 
-use super::direct::{Strategy, direct_light, emission_weight, manifold_weight};
+use super::direct::{
+    Strategy, area_emission_weight, direct_light, emission_weight, manifold_weight,
+};
 use super::manifold;
 use super::manifold::{Chain, WalkNumbers, WalkVertex};
 use super::path::{ManifoldVertex, PathSample, PathState};
@@ -258,13 +260,7 @@ where
                             manifold::density(world, setup, v.p, v.d, ray.at(t), index, v.chain);
                         manifold_weight(strategy, p_walk, v.pdf, false)
                     }
-                    _ => emission_weight(world, strategy, &path, || {
-                        let origin = path.prev.map_or(ray.origin, |v| v.p);
-                        (
-                            LightRef::Area(index),
-                            world.areas[index].pdf(origin, ray.dir, t),
-                        )
-                    }),
+                    _ => area_emission_weight(world, strategy, &path, &ray, (index, t)),
                 };
                 path.add_emission(le, w);
                 if path.depth == 0 {

@@ -8,7 +8,7 @@ use crate::bsdf::power_heuristic;
 use crate::geometry::{MediumId, Ray, offset_origin};
 use crate::light::LightSample;
 use crate::render::camera::CameraRays;
-use crate::render::direct::{Strategy, emission_weight};
+use crate::render::direct::{Strategy, area_emission_weight, emission_weight};
 use crate::render::filter::FilterSampler;
 use crate::render::path::{PathSample, PathState};
 use crate::render::shading::{SurfaceBsdf, shade};
@@ -246,13 +246,7 @@ fn vertex<'a>(
         Some(Hit::Light { index, t }) => {
             let le = world.areas[index]
                 .emission::<RgbSample>(world.areas[index].emitted(-ray.dir), &path.lambda);
-            let w = emission_weight(world, strategy, path, || {
-                let origin = path.prev.map_or(ray.origin, |v| v.p);
-                (
-                    LightRef::Area(index),
-                    world.areas[index].pdf(origin, ray.dir, t),
-                )
-            });
+            let w = area_emission_weight(world, strategy, path, &ray, (index, t));
             path.add_emission(le, w);
             if path.depth == 0 {
                 out.depth = Some(t);
