@@ -126,15 +126,16 @@ fn lane_row(
 ) -> Vec<PixelSums> {
     let mut sums = row.to_vec();
     for (k, chunk) in sums.chunks_mut(lanes::simd::L).enumerate() {
-        let x = x0 + (k * lanes::simd::L) as u32;
+        let (x, count) = (x0 + (k * lanes::simd::L) as u32, chunk.len() as u32);
+        let packet = |sample| lanes::trace::Packet {
+            x0: x,
+            y,
+            count,
+            sample,
+        };
+        let mut samplers = lanes::trace::packet_samplers(setup, packet(samples.start));
         for s in samples.clone() {
-            let packet = lanes::trace::Packet {
-                x0: x,
-                y,
-                count: chunk.len() as u32,
-                sample: s,
-            };
-            let out = lanes::dispatch(world, setup, packet);
+            let out = lanes::dispatch(world, setup, packet(s), &mut samplers);
             for (p, o) in chunk.iter_mut().zip(&out) {
                 p.add(o);
             }
@@ -269,14 +270,11 @@ where
                         None => {
                             for (x, &pixel_sums) in (x0..x1).zip(row) {
                                 let mut p = pixel_sums;
+                                let pixel = u64::from(y) * u64::from(w) + u64::from(x);
+                                let mut sampler =
+                                    PixelSampler::new(settings.sampler, settings.seed, pixel, done);
                                 for s in done..end {
-                                    let pixel = u64::from(y) * u64::from(w) + u64::from(x);
-                                    let mut sampler = PixelSampler::new(
-                                        settings.sampler,
-                                        settings.seed,
-                                        pixel,
-                                        s,
-                                    );
+                                    sampler.restart(s);
                                     let offset = filter.sample(sampler.get2d());
                                     let lens = sampler.get2d();
                                     let film_pt =

@@ -92,7 +92,7 @@ pub mod slots {
     }
 }
 
-pub use pixel::{PixelSampler, SamplerKind};
+pub use pixel::{PixelSampler, SamplerKind, pairs_side_by_side};
 pub use warp::concentric_disc;
 
 /// SplitMix64's finaliser: a bijective 64-bit mixer with full avalanche.

@@ -2,7 +2,7 @@
 //! `(seed, pixel, sample index, dimension)`, so a render is bit-identical for any thread count and
 //! any order of tiles (docs/design.md §8).
 
-use super::sobol::{fixed_to_unit, scrambled_pair};
+use super::sobol::{fixed_to_unit, scrambled_pair_reversed, scrambled_pairs_reversed};
 use super::{mix64, to_unit_f32};
 use glam::Vec2;
 
@@ -37,7 +37,22 @@ pub struct PixelSampler {
     kind: SamplerKind,
     pixel_key: u64,
     index: u32,
+    /// `index` bit-reversed (what the Sobol' scramble starts from), formed once per sample.
+    reversed_index: u32,
     slot: u32,
+    /// The scramble seeds of the first [`CACHED_SLOTS`] slots, kept between the samples of the
+    /// pixel ([`PixelSampler::restart`]): they depend on the pixel and the slot, not the sample.
+    seeds: SeedCache,
+}
+
+/// Dimension slots whose seeds a [`PixelSampler`] keeps (the camera's two and ten bounces).
+const CACHED_SLOTS: usize = 64;
+
+/// The seeds of the slots drawn so far ([`seeds_of`]); bit `k` of `filled` says slot `k` is set.
+#[derive(Clone, Debug)]
+struct SeedCache {
+    filled: u64,
+    seeds: [[u32; 3]; CACHED_SLOTS],
 }
 
 impl PixelSampler {
@@ -48,8 +63,22 @@ impl PixelSampler {
             kind,
             pixel_key: mix64(mix64(seed ^ 0x5bd1_e995_7f4a_7c15).wrapping_add(pixel)),
             index,
+            reversed_index: index.reverse_bits(),
             slot: 0,
+            seeds: SeedCache {
+                filled: 0,
+                seeds: [[0; 3]; CACHED_SLOTS],
+            },
         }
+    }
+
+    /// Starts sample `index` of the same pixel: the same numbers as a new sampler of that sample,
+    /// without forming the pixel's slot seeds again.
+    #[inline]
+    pub fn restart(&mut self, index: u32) {
+        self.index = index;
+        self.reversed_index = index.reverse_bits();
+        self.slot = 0;
     }
 
     /// The sample index.
@@ -69,18 +98,34 @@ impl PixelSampler {
     }
 
     /// The key of dimension slot `slot` of this pixel: with a sample index, it determines the
-    /// slot's pair ([`pair_of`]). The same for every sample of the pixel, so a renderer drawing
-    /// several samples of one pixel at once computes it once.
+    /// slot's pair. The same for every sample of the pixel, so the sampler keeps the seeds made
+    /// from it between samples ([`PixelSampler::restart`]).
     #[inline]
     pub fn key_of(&self, slot: u32) -> u64 {
         mix64(self.pixel_key ^ u64::from(slot).wrapping_mul(0x9e37_79b9_7f4a_7c15))
     }
 
-    #[inline]
-    fn slot_key(&mut self) -> u64 {
-        let k = self.key_of(self.slot);
+    /// The seeds of the next slot (from the cache when an earlier sample of the pixel drew it),
+    /// and the counter moved on.
+    #[inline(always)]
+    fn next_seeds(&mut self) -> [u32; 3] {
+        let slot = self.slot;
         self.slot += 1;
-        k
+        self.seeds_at(slot)
+    }
+
+    /// The seeds of slot `slot` (kept for the slots below [`CACHED_SLOTS`]).
+    #[inline(always)]
+    fn seeds_at(&mut self, slot: u32) -> [u32; 3] {
+        if slot as usize >= CACHED_SLOTS {
+            return seeds_of(self.kind, self.key_of(slot));
+        }
+        let bit = 1u64 << slot;
+        if self.seeds.filled & bit == 0 {
+            self.seeds.seeds[slot as usize] = seeds_of(self.kind, self.key_of(slot));
+            self.seeds.filled |= bit;
+        }
+        self.seeds.seeds[slot as usize]
     }
 
     /// One uniform number in `[0, 1)`.
@@ -92,37 +137,82 @@ impl PixelSampler {
     /// A uniform pair in `[0, 1)²`.
     #[inline(always)] // as `pair`
     pub fn get2d(&mut self) -> Vec2 {
-        let key = self.slot_key();
-        self.pair(key)
+        let seeds = self.next_seeds();
+        pair_from_seeds(self.kind, seeds, self.index, self.reversed_index)
     }
 
     /// The pair of slot `slot`, without moving the counter: for the reserved slots of
     /// [`super::slots`] (wavelengths, medium distances) that live outside the bounce blocks.
     #[inline(always)]
     pub fn get2d_at(&self, slot: u32) -> Vec2 {
-        self.pair(self.key_of(slot))
-    }
-
-    // Always inlined: it runs a few times per path vertex, and when the integrator grew (the
-    // spectral variant, stop 28) LLVM stopped inlining it, which cost RGB renders about 3 %.
-    #[inline(always)]
-    fn pair(&self, key: u64) -> Vec2 {
-        pair_of(self.kind, key, self.index)
+        let seeds = seeds_of(self.kind, self.key_of(slot));
+        pair_from_seeds(self.kind, seeds, self.index, self.reversed_index)
     }
 }
 
-/// The pair of the slot with key `key` ([`PixelSampler::key_of`]) for sample `index`.
+/// The pairs of slot `slots[k]` of sampler `samplers[k]`, side by side: what `skip_to(slots[k])`
+/// then `get2d()` would draw from each sampler `k` that is `active[k]` (the others' pairs are
+/// meaningless; counters are left as they are). The samplers must draw the same sample index with
+/// the same kind (the lane loop's packet: one sample of adjacent pixels); the Sobol' scrambles
+/// then run as vector instructions over the samplers.
 #[inline(always)]
-pub fn pair_of(kind: SamplerKind, key: u64, index: u32) -> Vec2 {
+pub fn pairs_side_by_side<const N: usize>(
+    samplers: &mut [PixelSampler; N],
+    slots: [u32; N],
+    active: [bool; N],
+) -> [Vec2; N] {
+    let kind = samplers[0].kind;
+    let (index, reversed_index) = (samplers[0].index, samplers[0].reversed_index);
+    debug_assert!(samplers.iter().all(|s| s.kind == kind && s.index == index));
+    let mut seeds = [[0u32; 3]; N];
+    for k in 0..N {
+        if active[k] {
+            seeds[k] = samplers[k].seeds_at(slots[k]);
+        }
+    }
+    let mut out = [Vec2::ZERO; N];
     match kind {
         SamplerKind::Independent => {
+            for k in 0..N {
+                out[k] = pair_from_seeds(kind, seeds[k], index, reversed_index);
+            }
+        }
+        SamplerKind::Sobol => {
+            let pairs = scrambled_pairs_reversed(reversed_index, &seeds);
+            for k in 0..N {
+                out[k] = Vec2::new(fixed_to_unit(pairs[k].0), fixed_to_unit(pairs[k].1));
+            }
+        }
+    }
+    out
+}
+
+/// The scramble seeds of the slot with key `key` ([`PixelSampler::key_of`]): the key's two
+/// halves, and for Sobol' a third word hashed from it.
+#[inline(always)]
+fn seeds_of(kind: SamplerKind, key: u64) -> [u32; 3] {
+    let third = match kind {
+        SamplerKind::Independent => 0,
+        SamplerKind::Sobol => mix64(key) as u32,
+    };
+    [key as u32, (key >> 32) as u32, third]
+}
+
+/// The pair of a slot with seeds `seeds` ([`seeds_of`]) for sample `index` (`reversed_index` its
+/// bit reversal).
+// Always inlined: it runs a few times per path vertex, and when the integrator grew (the
+// spectral variant, stop 28) LLVM stopped inlining it, which cost RGB renders about 3 %.
+#[inline(always)]
+fn pair_from_seeds(kind: SamplerKind, seeds: [u32; 3], index: u32, reversed_index: u32) -> Vec2 {
+    match kind {
+        SamplerKind::Independent => {
+            let key = u64::from(seeds[0]) | (u64::from(seeds[1]) << 32);
             let a = mix64(key ^ u64::from(index));
             let b = mix64(a ^ 0x2545_f491_4f6c_dd1d);
             Vec2::new(to_unit_f32(a), to_unit_f32(b))
         }
         SamplerKind::Sobol => {
-            let seeds = [key as u32, (key >> 32) as u32, mix64(key) as u32];
-            let (x, y) = scrambled_pair(index, seeds);
+            let (x, y) = scrambled_pair_reversed(reversed_index, seeds);
             Vec2::new(fixed_to_unit(x), fixed_to_unit(y))
         }
     }
@@ -146,6 +236,56 @@ mod tests {
             assert_ne!(a, draws(kind, 1, 3, 3));
             assert_ne!(a, draws(kind, 1, 2, 4));
             assert!(a.iter().all(|v| (0.0..1.0).contains(v)));
+        }
+    }
+
+    #[test]
+    fn a_restarted_sampler_draws_what_a_new_one_draws() {
+        for kind in [SamplerKind::Independent, SamplerKind::Sobol] {
+            let mut reused = PixelSampler::new(kind, 3, 41, 0);
+            // Samples of one pixel in the render loop's order, each drawing a different number of
+            // slots (some past the cache), plus a reserved slot.
+            for index in [0u32, 1, 2, 7, 3, 1 << 20, u32::MAX] {
+                reused.restart(index);
+                let mut fresh = PixelSampler::new(kind, 3, 41, index);
+                let n = 3 + index % 5 * 20;
+                for k in 0..n {
+                    assert_eq!(
+                        reused.get2d(),
+                        fresh.get2d(),
+                        "{kind:?} sample {index} slot {k}"
+                    );
+                }
+                assert_eq!(reused.slots_used(), n);
+                assert_eq!(
+                    reused.get2d_at(super::super::slots::WAVELENGTH),
+                    fresh.get2d_at(super::super::slots::WAVELENGTH)
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn pairs_side_by_side_are_each_samplers_own() {
+        for kind in [SamplerKind::Independent, SamplerKind::Sobol] {
+            for index in [0u32, 5, 1 << 31] {
+                let mut many: [PixelSampler; 8] =
+                    std::array::from_fn(|k| PixelSampler::new(kind, 2, 100 + k as u64, index));
+                // Per-lane slots, some past the seed cache; twice, the second time from it.
+                for slots in [
+                    [0u32, 1, 2, 9, 63, 64, 70, 200],
+                    [3; 8],
+                    [0, 1, 2, 9, 63, 64, 70, 200],
+                ] {
+                    let active = std::array::from_fn(|k| k != 5);
+                    let got = pairs_side_by_side(&mut many, slots, active);
+                    for k in (0..8).filter(|&k| active[k]) {
+                        let mut one = PixelSampler::new(kind, 2, 100 + k as u64, index);
+                        one.skip_to(slots[k]);
+                        assert_eq!(got[k], one.get2d(), "{kind:?} {index} lane {k}");
+                    }
+                }
+            }
         }
     }
 

@@ -111,7 +111,14 @@ static DIM1R: [[u32; 256]; 4] = {
 /// reversed tables ([`DIM1R`]). The same bits as the definition (tested against it).
 #[inline]
 pub fn scrambled_pair(index: u32, seeds: [u32; 3]) -> (u32, u32) {
-    let i = laine_karras(index.reverse_bits(), seeds[0]).reverse_bits();
+    scrambled_pair_reversed(index.reverse_bits(), seeds)
+}
+
+/// [`scrambled_pair`] of the sample index whose bit reversal is `reversed_index`: a sampler that
+/// draws many pairs of one sample reverses its index once.
+#[inline]
+pub fn scrambled_pair_reversed(reversed_index: u32, seeds: [u32; 3]) -> (u32, u32) {
+    let i = laine_karras(reversed_index, seeds[0]).reverse_bits();
     let dim1_reversed = DIM1R[0][(i & 0xff) as usize]
         ^ DIM1R[1][((i >> 8) & 0xff) as usize]
         ^ DIM1R[2][((i >> 16) & 0xff) as usize]
@@ -120,6 +127,38 @@ pub fn scrambled_pair(index: u32, seeds: [u32; 3]) -> (u32, u32) {
         laine_karras(i, seeds[1]).reverse_bits(),
         laine_karras(dim1_reversed, seeds[2]).reverse_bits(),
     )
+}
+
+/// [`scrambled_pair_reversed`] for `N` slots of one sample side by side (`seeds[k]` slot `k`'s),
+/// written as loops over the slots that the compiler turns into vector instructions (the lane
+/// loop, `render::lanes`, draws a bounce's numbers for all its paths at once). The same bits as
+/// `N` calls (tested).
+// Plain loops over arrays: `std::array::from_fn` goes through a function that is not inlined
+// into a caller compiled for a wider instruction set, and is then not vectorised.
+#[inline(always)]
+pub fn scrambled_pairs_reversed<const N: usize>(
+    reversed_index: u32,
+    seeds: &[[u32; 3]; N],
+) -> [(u32, u32); N] {
+    let mut i = [0u32; N];
+    for k in 0..N {
+        i[k] = laine_karras(reversed_index, seeds[k][0]).reverse_bits();
+    }
+    let mut dim1_reversed = [0u32; N];
+    for k in 0..N {
+        dim1_reversed[k] = DIM1R[0][(i[k] & 0xff) as usize]
+            ^ DIM1R[1][((i[k] >> 8) & 0xff) as usize]
+            ^ DIM1R[2][((i[k] >> 16) & 0xff) as usize]
+            ^ DIM1R[3][(i[k] >> 24) as usize];
+    }
+    let mut out = [(0u32, 0u32); N];
+    for k in 0..N {
+        out[k] = (
+            laine_karras(i[k], seeds[k][1]).reverse_bits(),
+            laine_karras(dim1_reversed[k], seeds[k][2]).reverse_bits(),
+        );
+    }
+    out
 }
 
 #[cfg(test)]
@@ -231,6 +270,25 @@ mod tests {
                     definition(index, s),
                     "{index} {s:?}"
                 );
+            }
+        }
+    }
+
+    #[test]
+    fn pairs_side_by_side_are_the_pairs_one_by_one() {
+        let mut h = 0x2545_f491u32;
+        let mut next = || {
+            h ^= h << 13;
+            h ^= h >> 17;
+            h ^= h << 5;
+            h
+        };
+        for _ in 0..2000 {
+            let index = next();
+            let seeds: [[u32; 3]; 8] = std::array::from_fn(|_| [next(), next(), next()]);
+            let side_by_side = scrambled_pairs_reversed(index.reverse_bits(), &seeds);
+            for (k, s) in seeds.iter().enumerate() {
+                assert_eq!(side_by_side[k], scrambled_pair(index, *s));
             }
         }
     }

@@ -17,6 +17,7 @@ pub use trace::trace_packet;
 use super::path::PathSample;
 use super::world::World;
 use crate::geometry::MediumId;
+use crate::sampler::PixelSampler;
 use simd::L;
 
 /// Why `world` cannot be traced in lanes (`None`: it can): the scalar integrator's media,
@@ -64,22 +65,29 @@ pub fn scalar_because(effects: &crate::scene::Effects) -> Option<&'static str> {
 /// for that instruction set too. (A closure handed to the dispatcher is not inlined into it:
 /// the kernel is this named type's method.)
 #[inline]
-pub fn dispatch(world: &World, setup: &trace::Setup, packet: trace::Packet) -> [PathSample; L] {
+pub fn dispatch(
+    world: &World,
+    setup: &trace::Setup,
+    packet: trace::Packet,
+    samplers: &mut [PixelSampler; L],
+) -> [PathSample; L] {
     struct Kernel<'a> {
         world: &'a World,
         setup: &'a trace::Setup<'a>,
         packet: trace::Packet,
+        samplers: &'a mut [PixelSampler; L],
     }
     impl pulp::WithSimd for Kernel<'_> {
         type Output = [PathSample; L];
         #[inline(always)]
         fn with_simd<S: pulp::Simd>(self, _: S) -> [PathSample; L] {
-            trace_packet(self.world, self.setup, self.packet)
+            trace_packet(self.world, self.setup, self.packet, self.samplers)
         }
     }
     pulp::Arch::new().dispatch(Kernel {
         world,
         setup,
         packet,
+        samplers,
     })
 }

@@ -13,7 +13,7 @@ use crate::render::filter::FilterSampler;
 use crate::render::path::{PathSample, PathState};
 use crate::render::shading::{SurfaceBsdf, shade};
 use crate::render::world::{Hit, LightRef, World};
-use crate::sampler::{PixelSampler, SamplerKind, slots};
+use crate::sampler::{PixelSampler, SamplerKind, pairs_side_by_side, slots};
 use crate::spectrum::{RgbSample, RgbWavelengths, Spectral};
 use glam::Vec2;
 
@@ -51,21 +51,36 @@ pub struct Setup<'a> {
     pub strategy: Strategy,
 }
 
-/// Traces the packet; lane `i` holds pixel `x0 + i`'s sample (lanes past `count` are empty).
-#[inline(always)]
-pub fn trace_packet(world: &World, setup: &Setup, packet: Packet) -> [PathSample; L] {
-    let live = M::from_fn(|i| (i as u32) < packet.count);
-    let mut samplers: [PixelSampler; L] = std::array::from_fn(|i| {
+/// The samplers of a packet's pixels ([`trace_packet`] restarts them at its sample), made once
+/// for all the samples of the pixels.
+pub fn packet_samplers(setup: &Setup, packet: Packet) -> [PixelSampler; L] {
+    std::array::from_fn(|i| {
         let x = packet.x0 + (i as u32).min(packet.count - 1);
         let pixel = u64::from(packet.y) * u64::from(setup.width) + u64::from(x);
         PixelSampler::new(setup.sampler, setup.seed, pixel, packet.sample)
-    });
-    // Camera rays (the render loop's order: filter offset, then lens).
+    })
+}
+
+/// Traces the packet; lane `i` holds pixel `x0 + i`'s sample (lanes past `count` are empty).
+/// `samplers` are the packet's pixels' ([`packet_samplers`]).
+#[inline(always)]
+pub fn trace_packet(
+    world: &World,
+    setup: &Setup,
+    packet: Packet,
+    samplers: &mut [PixelSampler; L],
+) -> [PathSample; L] {
+    let live = M::from_fn(|i| (i as u32) < packet.count);
+    for s in samplers.iter_mut() {
+        s.restart(packet.sample);
+    }
+    // Camera rays (the render loop's slots: filter offset, then lens).
+    let film_u = pairs_side_by_side(samplers, [slots::FILM; L], live.0);
+    let lens_u = pairs_side_by_side(samplers, [slots::LENS; L], live.0);
     let mut origin = V3::splat(glam::Vec3::ZERO);
     let mut dir = V3::splat(glam::Vec3::ZERO);
-    for (i, s) in samplers.iter_mut().enumerate() {
-        let offset = setup.filter.sample(s.get2d());
-        let lens = s.get2d();
+    for i in 0..L {
+        let (offset, lens) = (setup.filter.sample(film_u[i]), lens_u[i]);
         let x = packet.x0 + (i as u32).min(packet.count - 1);
         let film = Vec2::new(x as f32 + 0.5, packet.y as f32 + 0.5) + offset;
         let r = setup.rays.ray(film, lens);
@@ -80,12 +95,15 @@ pub fn trace_packet(world: &World, setup: &Setup, packet: Packet) -> [PathSample
         std::array::from_fn(|_| PathState::new(RgbWavelengths, MediumId::OUTSIDE));
     let mut alive = live;
     while alive.any() {
-        // Phase 1: intersect.
+        // Phase 1: intersect, and the bounce's numbers of every lane.
         for i in alive.lanes() {
-            samplers[i].skip_to(slots::bounce(paths[i].depth));
             out[i].rays += 1;
         }
         let found = intersect(world, alive, origin, dir);
+        // Only a lane at a surface draws (one that left the scene or met a light ends).
+        let surface =
+            alive & M::from_fn(|i| matches!(found[i], Some(Hit::Stone(_) | Hit::Ground { .. })));
+        let draws = bounce_draws(samplers, &paths, surface);
         // Phases 2–4, lane by lane: emission, shading, the light sample and its BSDF value.
         let mut vertices: [Option<Vertex>; L] = [None; L];
         let mut shadow_o = V3::splat(glam::Vec3::ZERO);
@@ -97,7 +115,7 @@ pub fn trace_packet(world: &World, setup: &Setup, packet: Packet) -> [PathSample
             vertices[i] = vertex(
                 world,
                 setup,
-                &mut samplers[i],
+                &draws[i],
                 &mut paths[i],
                 &mut out[i],
                 ray,
@@ -127,7 +145,7 @@ pub fn trace_packet(world: &World, setup: &Setup, packet: Packet) -> [PathSample
             {
                 gather(world, setup.strategy, v, n, &mut paths[i]);
             }
-            match continue_path(world, v, &mut samplers[i], &mut paths[i]) {
+            match continue_path(world, v, &draws[i], &mut paths[i]) {
                 Some(r) => {
                     origin.set(i, r.origin);
                     dir.set(i, r.dir);
@@ -140,6 +158,52 @@ pub fn trace_packet(world: &World, setup: &Setup, packet: Packet) -> [PathSample
         out[i].radiance = paths[i].l.to_rgb(&paths[i].film);
     }
     out
+}
+
+/// A lane's numbers for one bounce: the slots `slots::bounce(depth) + 0 ..= 5` in the order the
+/// scalar integrator draws them (a 1-D number is its slot pair's first coordinate).
+#[derive(Clone, Copy, Default)]
+struct Draws {
+    /// The map's switch between layered BSDFs.
+    switch: f32,
+    /// The light's choice and the point on it.
+    light: f32,
+    point: Vec2,
+    /// The BSDF sample's lobe choice and direction.
+    uc: f32,
+    u: Vec2,
+    /// Russian roulette (drawn from [`RR_DEPTH`] on).
+    roulette: f32,
+}
+
+/// The numbers of the bounce of every lane in `active`, drawn side by side (the scrambles as
+/// vector instructions); the other lanes' numbers are meaningless.
+#[inline(always)]
+fn bounce_draws(
+    samplers: &mut [PixelSampler; L],
+    paths: &[PathState<RgbSample>; L],
+    active: M,
+) -> [Draws; L] {
+    if !active.any() {
+        return [Draws::default(); L];
+    }
+    let first: [u32; L] = std::array::from_fn(|i| slots::bounce(paths[i].depth));
+    let mut at = |k: u32| pairs_side_by_side(samplers, first.map(|f| f + k), active.0);
+    let (switch, light, point, uc, u) = (at(0), at(1), at(2), at(3), at(4));
+    // Roulette follows the scattering, which counts one more bounce.
+    let roulette = if active.lanes().any(|i| paths[i].depth + 1 >= RR_DEPTH) {
+        at(5)
+    } else {
+        [Vec2::ZERO; L]
+    };
+    std::array::from_fn(|i| Draws {
+        switch: switch[i].x,
+        light: light[i].x,
+        point: point[i],
+        uc: uc[i].x,
+        u: u[i],
+        roulette: roulette[i].x,
+    })
 }
 
 /// The first hit of each live lane's ray (unit direction) within `(0, ∞)`: the stone, the floor,
@@ -227,7 +291,7 @@ struct LightPath {
 fn vertex<'a>(
     world: &'a World,
     setup: &Setup,
-    sampler: &mut PixelSampler,
+    draws: &Draws,
     path: &mut PathState<RgbSample>,
     out: &mut PathSample,
     ray: Ray,
@@ -256,14 +320,20 @@ fn vertex<'a>(
         Some(h) => h,
     };
     let wo = -ray.dir;
-    let u_switch = sampler.get1d();
-    let sb = shade(world, &hit, wo, u_switch, path.lambda, path.depth == 0, out)?;
+    let sb = shade(
+        world,
+        &hit,
+        wo,
+        draws.switch,
+        path.lambda,
+        path.depth == 0,
+        out,
+    )?;
     if path.bounces() >= setup.max_depth {
         return None;
     }
     let wo_local = sb.frame.to_local(wo);
-    let u_light = sampler.get1d();
-    let u_point = sampler.get2d();
+    let (u_light, u_point) = (draws.light, draws.point);
     let looked = strategy != Strategy::BsdfOnly && !sb.flags().is_specular_only();
     let nee = if looked {
         light_path(world, &sb, wo_local, u_light, u_point)
@@ -350,11 +420,10 @@ fn gather(
 fn continue_path(
     world: &World,
     v: &Vertex,
-    sampler: &mut PixelSampler,
+    draws: &Draws,
     path: &mut PathState<RgbSample>,
 ) -> Option<Ray> {
-    let uc = sampler.get1d();
-    let u = sampler.get2d();
+    let (uc, u) = (draws.uc, draws.u);
     let bs = v.sb.sample::<RgbSample>(v.wo_local, uc, u, &path.lambda)?;
     if world.transmission_off && bs.flags.is_transmission() {
         return None;
@@ -367,7 +436,7 @@ fn continue_path(
     }
     if path.depth >= RR_DEPTH {
         let q = path.survival();
-        if !(sampler.get1d() < q) {
+        if !(draws.roulette < q) {
             return None;
         }
         path.beta *= 1.0 / q;
