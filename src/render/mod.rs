@@ -242,6 +242,7 @@ where
                 width: w,
                 max_depth: settings.max_depth,
                 strategy: control.strategy,
+                leading_field: world.map.leading_field(),
             });
     let step = pass_size(settings.spp);
     let last = control

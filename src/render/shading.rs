@@ -12,6 +12,7 @@ use crate::geometry::{Frame, MediumId};
 use crate::spectrum::Spectral;
 use crate::spectrum::fluorescence::Fluorescence;
 use crate::texture::bump::facet_frame;
+use crate::texture::map::MapQuery;
 use glam::{Vec2, Vec3};
 
 /// What is known about a surface hit before its BSDF is built.
@@ -159,13 +160,14 @@ impl<'a> SurfaceBsdf<'a> {
 /// viewer); records the first-hit AOVs when `first`. `None` for a light or an unused material.
 ///
 /// # Arguments
-/// * `u_switch` – the bounce's map-switch number (stochastic blends of the map tree).
+/// * `map` – the bounce's map-switch number (stochastic blends of the map tree), or a
+///   [`MapQuery`] that also holds a field's value at the hit already evaluated (the lane loop's).
 /// * `lambda` – the path's wavelengths.
 pub fn shade<'a, W: Copy>(
     world: &'a World,
     hit: &Hit,
     wo: Vec3,
-    u_switch: f32,
+    map: impl Into<MapQuery>,
     lambda: W,
     first: bool,
     out: &mut PathSample,
@@ -177,7 +179,7 @@ pub fn shade<'a, W: Copy>(
             let front = wo.dot(h.ng) >= 0.0;
             let (ng, ns) = if !front { (-h.ng, -h.ns) } else { (h.ng, h.ns) };
             let ns = if wo.dot(ns) > 0.0 { ns } else { ng };
-            let look = world.map.lookup(h.p_object, u_switch);
+            let look = world.map.lookup_knowing(h.p_object, map.into());
             t_hit = h.t;
             ShadingContext {
                 p: h.p,

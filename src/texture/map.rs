@@ -28,6 +28,24 @@ use super::voronoi::Voronoi;
 use crate::sampler::{mix64, to_unit_f32};
 use glam::Vec3;
 
+/// What a map lookup is given besides the point: the switch number `u ∈ [0, 1)` (stochastic
+/// blends) and, optionally, a field's value at the point already evaluated (`known`: the lane loop
+/// evaluates the map's leading field for all its lanes at once, [`Map::leading_field`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MapQuery {
+    /// The switch number.
+    pub u: f32,
+    /// A field and its value at the point.
+    pub known: Option<(FieldId, f32)>,
+}
+
+impl From<f32> for MapQuery {
+    /// A query with switch number `u` and nothing known.
+    fn from(u: f32) -> Self {
+        MapQuery { u, known: None }
+    }
+}
+
 /// Index of a node in its [`Map`].
 pub type NodeId = u32;
 
@@ -359,10 +377,32 @@ impl Map {
     /// The material, facet and visited cells at object-space point `p`; `u ∈ [0,1)` decides the
     /// stochastic switch bands. Allocation-free.
     pub fn lookup(&self, p: Vec3, u: f32) -> MapHit {
+        self.lookup_knowing(p, MapQuery::from(u))
+    }
+
+    /// The field of the switch that decides most lookups: the first switch reached from the root
+    /// through overlays' lower maps (a lookup evaluates it unless an upper map covers the point).
+    /// The lane loop evaluates it for all its lanes at once ([`Map::lookup_knowing`]).
+    pub fn leading_field(&self) -> Option<FieldId> {
+        let mut node = self.root;
+        for _ in 0..self.nodes.len() {
+            match self.nodes[node as usize] {
+                MapNode::Overlay { under, .. } => node = under,
+                MapNode::Switch { field, .. } => return Some(field),
+                _ => return None,
+            }
+        }
+        None
+    }
+
+    /// [`Map::lookup`] with a [`MapQuery`]: its `known` field value at `p` is read by every switch
+    /// on that field instead of evaluating it (a field's value depends only on the point).
+    pub fn lookup_knowing(&self, p: Vec3, query: MapQuery) -> MapHit {
+        let MapQuery { u, known } = query;
         let mut trail = CellTrail::EMPTY;
         let mut u = if (0.0..1.0).contains(&u) { u } else { 0.5 };
         let (material, facet) = self
-            .visit(self.root, p, &mut u, &mut trail)
+            .visit(self.root, p, known, &mut u, &mut trail)
             .unwrap_or((0, None)); // unreachable: `new` proves the root opaque
         MapHit {
             material,
@@ -375,6 +415,7 @@ impl Map {
         &self,
         node: NodeId,
         p: Vec3,
+        known: Option<(FieldId, f32)>,
         u: &mut f32,
         trail: &mut CellTrail,
     ) -> Option<(u32, Option<Vec3>)> {
@@ -389,12 +430,12 @@ impl Map {
                 }
                 let k = v.pick(cell.id, &self.entries);
                 let child = self.entries[v.first as usize + k].node;
-                let (m, facet) = self.visit(child, p, u, trail)?;
+                let (m, facet) = self.visit(child, p, known, u, trail)?;
                 Some((m, facet.or_else(|| v.bump.map(|b| b.normal(cell.id)))))
             }
             MapNode::Overlay { under, over } => self
-                .visit(over, p, u, trail)
-                .or_else(|| self.visit(under, p, u, trail)),
+                .visit(over, p, known, u, trail)
+                .or_else(|| self.visit(under, p, known, u, trail)),
             MapNode::Switch {
                 field,
                 first,
@@ -402,8 +443,12 @@ impl Map {
                 blend,
             } => {
                 let stops = &self.stops[first as usize..(first + count) as usize];
-                let k = choose_stop(stops, self.fields.eval(field, p), blend, u);
-                self.visit(stops[k].node, p, u, trail)
+                let v = match known {
+                    Some((f, v)) if f == field => v,
+                    _ => self.fields.eval(field, p),
+                };
+                let k = choose_stop(stops, v, blend, u);
+                self.visit(stops[k].node, p, known, u, trail)
             }
         }
     }

@@ -60,6 +60,32 @@ fn lerp(t: f32, a: f32, b: f32) -> f32 {
 /// Perlin gradient noise at `p` (lattice units) for `seed`; about `[−1, 1]`, finite for every
 /// input (non-finite inputs read as the origin).
 pub fn perlin(p: Vec3, seed: u32) -> f32 {
+    let (lattice, f) = locate(p);
+    noise_at(lattice, f, hash32(seed ^ 0x9e37_79b9))
+}
+
+/// [`perlin`] at `N` points side by side, as loops over the points that the compiler turns into
+/// vector instructions where the caller is compiled for them (the lane loop's kernel,
+/// `render::lanes`): the same operations on each point, so the same bits as `N` calls (tested).
+#[inline(always)]
+pub fn perlin_side_by_side<const N: usize>(p: &[Vec3; N], seed: u32) -> [f32; N] {
+    let mut lattice = [[0u32; 3]; N];
+    let mut f = [Vec3::ZERO; N];
+    for k in 0..N {
+        (lattice[k], f[k]) = locate(p[k]);
+    }
+    let s = hash32(seed ^ 0x9e37_79b9);
+    let mut out = [0.0f32; N];
+    for k in 0..N {
+        out[k] = noise_at(lattice[k], f[k], s);
+    }
+    out
+}
+
+/// The lattice cell holding `p` (coordinates wrapping at 2³² — far beyond any recipe, see the
+/// module docs) and the offset within it; a non-finite `p` reads as the origin.
+#[inline(always)]
+fn locate(p: Vec3) -> ([u32; 3], Vec3) {
     let p = if p.is_finite() {
         p.as_dvec3()
     } else {
@@ -67,13 +93,19 @@ pub fn perlin(p: Vec3, seed: u32) -> f32 {
     };
     let cell = p.floor();
     let f = (p - cell).as_vec3();
-    // Lattice coordinates wrap at 2³² — far beyond any recipe (see the module docs).
-    let (xi, yi, zi) = (
-        cell.x as i64 as u32,
-        cell.y as i64 as u32,
-        cell.z as i64 as u32,
-    );
-    let s = hash32(seed ^ 0x9e37_79b9);
+    (
+        [
+            cell.x as i64 as u32,
+            cell.y as i64 as u32,
+            cell.z as i64 as u32,
+        ],
+        f,
+    )
+}
+
+/// The noise of lattice cell `[xi, yi, zi]` at offset `f` within it; `s` is the hashed seed.
+#[inline(always)]
+fn noise_at([xi, yi, zi]: [u32; 3], f: Vec3, s: u32) -> f32 {
     let hz = [hash32(s ^ zi), hash32(s ^ zi.wrapping_add(1))];
     let hyz = |y: u32, z: usize| hash32(hz[z] ^ y.wrapping_mul(0x85eb_ca6b));
     let corner = |x: u32, y: u32, z: usize| hash32(hyz(y, z) ^ x.wrapping_mul(0xc2b2_ae35));
@@ -143,6 +175,48 @@ impl Octaves {
         let (a, b, c) = (hash32(h ^ 1), hash32(h ^ 2), hash32(h ^ 3));
         let unit = |x: u32| (x >> 8) as f32 * (1.0 / 16_777_216.0);
         (h, Vec3::new(unit(a), unit(b), unit(c)))
+    }
+
+    /// [`Octaves::fbm`] at `N` points side by side (see [`perlin_side_by_side`]).
+    #[inline(always)]
+    pub fn fbm_side_by_side<const N: usize>(&self, p: &[Vec3; N]) -> [f32; N] {
+        self.sum_side_by_side(p, |n| n)
+    }
+
+    /// [`Octaves::turbulence`] at `N` points side by side (see [`perlin_side_by_side`]).
+    #[inline(always)]
+    pub fn turbulence_side_by_side<const N: usize>(&self, p: &[Vec3; N]) -> [f32; N] {
+        self.sum_side_by_side(p, f32::abs)
+    }
+
+    /// [`Octaves::sum`] at `N` points: each point's terms in the same order.
+    #[inline(always)]
+    fn sum_side_by_side<const N: usize>(
+        &self,
+        p: &[Vec3; N],
+        shape: impl Fn(f32) -> f32,
+    ) -> [f32; N] {
+        let (mut total, mut norm) = ([0.0f32; N], 0.0f32);
+        let (mut amp, mut freq) = (1.0f32, 1.0f32);
+        for k in 0..self.octaves.max(1) {
+            let (seed, offset) = self.octave(k);
+            let mut q = [Vec3::ZERO; N];
+            for i in 0..N {
+                q[i] = p[i] * freq + offset;
+            }
+            let n = perlin_side_by_side(&q, seed);
+            for i in 0..N {
+                total[i] += amp * shape(n[i]);
+            }
+            norm += amp;
+            amp *= self.gain;
+            freq *= self.lacunarity;
+        }
+        let mut out = [0.0f32; N];
+        for i in 0..N {
+            out[i] = if norm > 0.0 { total[i] / norm } else { 0.0 };
+        }
+        out
     }
 
     #[inline]
@@ -225,6 +299,41 @@ mod tests {
         assert!(same < 10, "{same} of 1000 repeat");
         assert_eq!(perlin(Vec3::NAN, 1), 0.0);
         assert!(perlin(Vec3::splat(-1e6 + 0.37), 1).is_finite());
+    }
+
+    #[test]
+    fn side_by_side_is_one_by_one() {
+        let o = Octaves {
+            octaves: 5,
+            gain: 0.55,
+            lacunarity: 2.1,
+            seed: 11,
+        };
+        let mut pts = points(8 * 4000, 300.0, 6);
+        // Lattice points, huge and non-finite inputs among them.
+        pts[..8].copy_from_slice(&[
+            Vec3::ZERO,
+            Vec3::new(3.0, -7.0, 12.0),
+            Vec3::splat(-1e6 + 0.37),
+            Vec3::splat(3e9),
+            Vec3::NAN,
+            Vec3::new(f32::INFINITY, 0.0, 1.0),
+            Vec3::splat(-0.0),
+            Vec3::splat(f32::MAX),
+        ]);
+        for chunk in pts.chunks_exact(8) {
+            let p: [Vec3; 8] = chunk.try_into().unwrap();
+            let (n, f, t) = (
+                perlin_side_by_side(&p, 9),
+                o.fbm_side_by_side(&p),
+                o.turbulence_side_by_side(&p),
+            );
+            for k in 0..8 {
+                assert_eq!(n[k].to_bits(), perlin(p[k], 9).to_bits(), "{:?}", p[k]);
+                assert_eq!(f[k].to_bits(), o.fbm(p[k]).to_bits(), "{:?}", p[k]);
+                assert_eq!(t[k].to_bits(), o.turbulence(p[k]).to_bits(), "{:?}", p[k]);
+            }
+        }
     }
 
     #[test]

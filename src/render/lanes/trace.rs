@@ -15,6 +15,8 @@ use crate::render::shading::{SurfaceBsdf, shade};
 use crate::render::world::{Hit, LightRef, World};
 use crate::sampler::{PixelSampler, SamplerKind, pairs_side_by_side, slots};
 use crate::spectrum::{RgbSample, RgbWavelengths, Spectral};
+use crate::texture::field::FieldId;
+use crate::texture::map::MapQuery;
 use glam::Vec2;
 
 /// Bounces after which Russian roulette may end a path (as the scalar integrator).
@@ -49,6 +51,9 @@ pub struct Setup<'a> {
     pub max_depth: u32,
     /// Direct-light estimators.
     pub strategy: Strategy,
+    /// The map's leading field ([`crate::texture::map::Map::leading_field`]), evaluated for all
+    /// the lanes at a stone at once.
+    pub leading_field: Option<FieldId>,
 }
 
 /// The samplers of a packet's pixels ([`trace_packet`] restarts them at its sample), made once
@@ -103,7 +108,12 @@ pub fn trace_packet(
         // Only a lane at a surface draws (one that left the scene or met a light ends).
         let surface =
             alive & M::from_fn(|i| matches!(found[i], Some(Hit::Stone(_) | Hit::Ground { .. })));
-        let draws = bounce_draws(samplers, &paths, surface);
+        let mut draws = bounce_draws(samplers, &paths, surface);
+        if let Some((field, values)) = leading_field(world, setup, &found, alive) {
+            for (d, v) in draws.iter_mut().zip(values) {
+                d.known = Some((field, v));
+            }
+        }
         // Phases 2–4, lane by lane: emission, shading, the light sample and its BSDF value.
         let mut vertices: [Option<Vertex>; L] = [None; L];
         let mut shadow_o = V3::splat(glam::Vec3::ZERO);
@@ -174,6 +184,8 @@ struct Draws {
     u: Vec2,
     /// Russian roulette (drawn from [`RR_DEPTH`] on).
     roulette: f32,
+    /// The map's leading field at the lane's stone hit, when evaluated side by side.
+    known: Option<(FieldId, f32)>,
 }
 
 /// The numbers of the bounce of every lane in `active`, drawn side by side (the scrambles as
@@ -203,7 +215,30 @@ fn bounce_draws(
         uc: uc[i].x,
         u: u[i],
         roulette: roulette[i].x,
+        known: None,
     })
+}
+
+/// The map's leading field at every live lane's stone hit, evaluated side by side (the noise as
+/// vector instructions), when two or more lanes met the stone; other lanes' values are
+/// meaningless and not read (their `shade` does not look the map up).
+#[inline(always)]
+fn leading_field(
+    world: &World,
+    setup: &Setup,
+    found: &[Option<Hit>; L],
+    alive: M,
+) -> Option<(FieldId, [f32; L])> {
+    let field = setup.leading_field?;
+    let mut points = [glam::Vec3::ZERO; L];
+    let mut stones = 0;
+    for i in alive.lanes() {
+        if let Some(Hit::Stone(h)) = &found[i] {
+            points[i] = h.p_object;
+            stones += 1;
+        }
+    }
+    (stones >= 2).then(|| (field, world.map.fields.eval_side_by_side(field, &points)))
 }
 
 /// The first hit of each live lane's ray (unit direction) within `(0, ∞)`: the stone, the floor,
@@ -324,7 +359,10 @@ fn vertex<'a>(
         world,
         &hit,
         wo,
-        draws.switch,
+        MapQuery {
+            u: draws.switch,
+            known: draws.known,
+        },
         path.lambda,
         path.depth == 0,
         out,
