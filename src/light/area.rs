@@ -595,7 +595,7 @@ mod tests {
         let Some(Strategy::Spherical(sr)) = l.strategy(Vec3::ZERO) else {
             panic!("edge-on: no spherical rectangle");
         };
-        let reference = 9.555_223_079_427_054_8e-6;
+        let reference = 9.555_223_079_427_055e-6;
         let rel = (sr.solid_angle - reference).abs() / reference;
         assert!(
             rel < 2e-8,

@@ -78,8 +78,8 @@ use crate::sampler::{PixelSampler, slots};
 use crate::spectrum::Spectral;
 use glam::Vec3;
 
-/// Bounces after which Russian roulette may end a path.
-const RR_DEPTH: u32 = 3;
+/// Bounces after which Russian roulette may end a path (the lane loop's too).
+pub(crate) const RR_DEPTH: u32 = 3;
 
 /// The probability that a path at a fluorescent base takes the fluorescent lobe (module docs).
 const FLUORESCENT_SHARE: f32 = 0.5;

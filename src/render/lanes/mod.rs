@@ -8,6 +8,7 @@
 //! speed of a render, never its image. They run the opaque RGB path loop ([`unsupported`] says
 //! why a scene needs the scalar loop instead).
 
+mod draws;
 pub mod simd;
 mod stone;
 pub mod trace;

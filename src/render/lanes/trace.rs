@@ -3,6 +3,7 @@
 //! ([`crate::render::integrator::trace_at`]) for an opaque RGB scene in the same order on its own
 //! numbers, so each lane's sample is bit for bit the scalar one.
 
+use super::draws::{Draws, bounce_draws, leading_field};
 use super::simd::{F, L, M, V3};
 use crate::bsdf::power_heuristic;
 use crate::geometry::{MediumId, Ray, offset_origin};
@@ -10,6 +11,7 @@ use crate::light::LightSample;
 use crate::render::camera::CameraRays;
 use crate::render::direct::{Strategy, area_emission_weight, emission_weight};
 use crate::render::filter::FilterSampler;
+use crate::render::integrator::RR_DEPTH;
 use crate::render::path::{PathSample, PathState};
 use crate::render::shading::{SurfaceBsdf, shade};
 use crate::render::world::{Hit, LightRef, World};
@@ -18,9 +20,6 @@ use crate::spectrum::{RgbSample, RgbWavelengths, Spectral};
 use crate::texture::field::FieldId;
 use crate::texture::map::MapQuery;
 use glam::Vec2;
-
-/// Bounces after which Russian roulette may end a path (as the scalar integrator).
-const RR_DEPTH: u32 = 3;
 
 /// What a packet traces: pixels `x0 .. x0 + count` of row `y`, sample `sample` of each.
 #[derive(Clone, Copy, Debug)]
@@ -109,7 +108,7 @@ pub fn trace_packet(
         let surface =
             alive & M::from_fn(|i| matches!(found[i], Some(Hit::Stone(_) | Hit::Ground { .. })));
         let mut draws = bounce_draws(samplers, &paths, surface);
-        if let Some((field, values)) = leading_field(world, setup, &found, alive) {
+        if let Some((field, values)) = leading_field(world, setup.leading_field, &found, alive) {
             for (d, v) in draws.iter_mut().zip(values) {
                 d.known = Some((field, v));
             }
@@ -168,77 +167,6 @@ pub fn trace_packet(
         out[i].radiance = paths[i].l.to_rgb(&paths[i].film);
     }
     out
-}
-
-/// A lane's numbers for one bounce: the slots `slots::bounce(depth) + 0 ..= 5` in the order the
-/// scalar integrator draws them (a 1-D number is its slot pair's first coordinate).
-#[derive(Clone, Copy, Default)]
-struct Draws {
-    /// The map's switch between layered BSDFs.
-    switch: f32,
-    /// The light's choice and the point on it.
-    light: f32,
-    point: Vec2,
-    /// The BSDF sample's lobe choice and direction.
-    uc: f32,
-    u: Vec2,
-    /// Russian roulette (drawn from [`RR_DEPTH`] on).
-    roulette: f32,
-    /// The map's leading field at the lane's stone hit, when evaluated side by side.
-    known: Option<(FieldId, f32)>,
-}
-
-/// The numbers of the bounce of every lane in `active`, drawn side by side (the scrambles as
-/// vector instructions); the other lanes' numbers are meaningless.
-#[inline(always)]
-fn bounce_draws(
-    samplers: &mut [PixelSampler; L],
-    paths: &[PathState<RgbSample>; L],
-    active: M,
-) -> [Draws; L] {
-    if !active.any() {
-        return [Draws::default(); L];
-    }
-    let first: [u32; L] = std::array::from_fn(|i| slots::bounce(paths[i].depth));
-    let mut at = |k: u32| pairs_side_by_side(samplers, first.map(|f| f + k), active.0);
-    let (switch, light, point, uc, u) = (at(0), at(1), at(2), at(3), at(4));
-    // Roulette follows the scattering, which counts one more bounce.
-    let roulette = if active.lanes().any(|i| paths[i].depth + 1 >= RR_DEPTH) {
-        at(5)
-    } else {
-        [Vec2::ZERO; L]
-    };
-    std::array::from_fn(|i| Draws {
-        switch: switch[i].x,
-        light: light[i].x,
-        point: point[i],
-        uc: uc[i].x,
-        u: u[i],
-        roulette: roulette[i].x,
-        known: None,
-    })
-}
-
-/// The map's leading field at every live lane's stone hit, evaluated side by side (the noise as
-/// vector instructions), when two or more lanes met the stone; other lanes' values are
-/// meaningless and not read (their `shade` does not look the map up).
-#[inline(always)]
-fn leading_field(
-    world: &World,
-    setup: &Setup,
-    found: &[Option<Hit>; L],
-    alive: M,
-) -> Option<(FieldId, [f32; L])> {
-    let field = setup.leading_field?;
-    let mut points = [glam::Vec3::ZERO; L];
-    let mut stones = 0;
-    for i in alive.lanes() {
-        if let Some(Hit::Stone(h)) = &found[i] {
-            points[i] = h.p_object;
-            stones += 1;
-        }
-    }
-    (stones >= 2).then(|| (field, world.map.fields.eval_side_by_side(field, &points)))
 }
 
 /// The first hit of each live lane's ray (unit direction) within `(0, ∞)`: the stone, the floor,
