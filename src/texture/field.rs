@@ -309,19 +309,8 @@ mod tests {
 
     #[test]
     fn side_by_side_is_one_by_one() {
-        let mut t = FieldTable::default();
-        let fbm = t
-            .add(FieldNode::Fbm {
-                inv_scale: 3.0,
-                octaves: octaves(1),
-            })
-            .unwrap();
-        let turb = t
-            .add(FieldNode::Turbulence {
-                inv_scale: 0.7,
-                octaves: octaves(2),
-            })
-            .unwrap();
+        // Every node kind, a marble, and a sum that overflows (read as f32::MAX).
+        let (mut t, ids) = every_kind();
         let marble = t
             .add(FieldNode::Marble {
                 inv_scale: 0.4,
@@ -330,9 +319,9 @@ mod tests {
                 octaves: octaves(3),
             })
             .unwrap();
-        let c = t.add(FieldNode::Constant(1e38)).unwrap();
-        let (first, count) = t.add_args(&[fbm, marble, c, c, c, c]);
-        let sum = t.add(FieldNode::Sum { first, count }).unwrap();
+        let big = t.add(FieldNode::Constant(1e38)).unwrap();
+        let (first, count) = t.add_args(&[marble, big, big, big, big]);
+        let over = t.add(FieldNode::Sum { first, count }).unwrap();
         let mut rng = Rng::new(4);
         let mut point = || Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * 50.0 - 25.0;
         for round in 0..2000 {
@@ -340,7 +329,7 @@ mod tests {
             if round == 0 {
                 (p[0], p[1], p[2]) = (Vec3::NAN, Vec3::splat(1e30), Vec3::ZERO);
             }
-            for id in [fbm, turb, marble, c, sum] {
+            for id in ids.into_iter().chain([marble, over]) {
                 let v = t.eval_side_by_side(id, &p);
                 for k in 0..8 {
                     assert_eq!(
@@ -423,9 +412,9 @@ mod tests {
         );
     }
 
-    /// Every value lies in the interval [`FieldTable::bounds`] gives.
-    #[test]
-    fn bounds_hold_every_value() {
+    /// A table of every node kind: fBm `a`, turbulence `b`, constant `c`, their sum and product,
+    /// and a remap of the sum (in that order of ids).
+    fn every_kind() -> (FieldTable, [FieldId; 6]) {
         let mut t = FieldTable::default();
         let a = t
             .add(FieldNode::Fbm {
@@ -451,6 +440,13 @@ mod tests {
                 clamp: false,
             })
             .unwrap();
+        (t, [a, b, c, sum, prod, remap])
+    }
+
+    /// Every value lies in the interval [`FieldTable::bounds`] gives.
+    #[test]
+    fn bounds_hold_every_value() {
+        let (mut t, [a, b, c, sum, prod, remap]) = every_kind();
         assert_eq!(t.bounds(sum), (-2.5, 3.5));
         assert_eq!(t.bounds(remap), (-3.75, 5.25));
         assert_eq!(t.bounds(c), (-0.5, -0.5));
