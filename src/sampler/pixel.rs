@@ -105,15 +105,6 @@ impl PixelSampler {
         mix64(self.pixel_key ^ u64::from(slot).wrapping_mul(0x9e37_79b9_7f4a_7c15))
     }
 
-    /// The seeds of the next slot (from the cache when an earlier sample of the pixel drew it),
-    /// and the counter moved on.
-    #[inline(always)]
-    fn next_seeds(&mut self) -> [u32; 3] {
-        let slot = self.slot;
-        self.slot += 1;
-        self.seeds_at(slot)
-    }
-
     /// The seeds of slot `slot` (kept for the slots below [`CACHED_SLOTS`]).
     #[inline(always)]
     fn seeds_at(&mut self, slot: u32) -> [u32; 3] {
@@ -137,7 +128,8 @@ impl PixelSampler {
     /// A uniform pair in `[0, 1)²`.
     #[inline(always)] // as `pair`
     pub fn get2d(&mut self) -> Vec2 {
-        let seeds = self.next_seeds();
+        let seeds = self.seeds_at(self.slot);
+        self.slot += 1;
         pair_from_seeds(self.kind, seeds, self.index, self.reversed_index)
     }
 

@@ -119,14 +119,19 @@ pub fn scrambled_pair(index: u32, seeds: [u32; 3]) -> (u32, u32) {
 #[inline]
 pub fn scrambled_pair_reversed(reversed_index: u32, seeds: [u32; 3]) -> (u32, u32) {
     let i = laine_karras(reversed_index, seeds[0]).reverse_bits();
-    let dim1_reversed = DIM1R[0][(i & 0xff) as usize]
-        ^ DIM1R[1][((i >> 8) & 0xff) as usize]
-        ^ DIM1R[2][((i >> 16) & 0xff) as usize]
-        ^ DIM1R[3][(i >> 24) as usize];
     (
         laine_karras(i, seeds[1]).reverse_bits(),
-        laine_karras(dim1_reversed, seeds[2]).reverse_bits(),
+        laine_karras(dim1_reversed(i), seeds[2]).reverse_bits(),
     )
+}
+
+/// `sobol_dim1(i).reverse_bits()`: four reads of [`DIM1R`].
+#[inline(always)]
+fn dim1_reversed(i: u32) -> u32 {
+    DIM1R[0][(i & 0xff) as usize]
+        ^ DIM1R[1][((i >> 8) & 0xff) as usize]
+        ^ DIM1R[2][((i >> 16) & 0xff) as usize]
+        ^ DIM1R[3][(i >> 24) as usize]
 }
 
 /// [`scrambled_pair_reversed`] for `N` slots of one sample side by side (`seeds[k]` slot `k`'s),
@@ -144,18 +149,15 @@ pub fn scrambled_pairs_reversed<const N: usize>(
     for k in 0..N {
         i[k] = laine_karras(reversed_index, seeds[k][0]).reverse_bits();
     }
-    let mut dim1_reversed = [0u32; N];
+    let mut dim1 = [0u32; N];
     for k in 0..N {
-        dim1_reversed[k] = DIM1R[0][(i[k] & 0xff) as usize]
-            ^ DIM1R[1][((i[k] >> 8) & 0xff) as usize]
-            ^ DIM1R[2][((i[k] >> 16) & 0xff) as usize]
-            ^ DIM1R[3][(i[k] >> 24) as usize];
+        dim1[k] = dim1_reversed(i[k]);
     }
     let mut out = [(0u32, 0u32); N];
     for k in 0..N {
         out[k] = (
             laine_karras(i[k], seeds[k][1]).reverse_bits(),
-            laine_karras(dim1_reversed[k], seeds[k][2]).reverse_bits(),
+            laine_karras(dim1[k], seeds[k][2]).reverse_bits(),
         );
     }
     out
