@@ -85,7 +85,7 @@ pub fn build_world(path: &Path, scene: &Scene, setup: &Setup) -> Result<World, W
 
 /// The files a loaded recipe reads besides itself: included libraries, the mesh, the
 /// environment map.
-fn recipe_inputs(recipe: &GemRecipe) -> Vec<(PathBuf, &'static str)> {
+pub(crate) fn recipe_inputs(recipe: &GemRecipe) -> Vec<(PathBuf, &'static str)> {
     let mut inputs: Vec<(PathBuf, &'static str)> = recipe
         .library
         .sources()

@@ -28,6 +28,7 @@ pub mod load;
 pub mod map;
 pub mod merge;
 pub mod plot;
+pub mod preview;
 pub mod regress;
 pub mod render;
 pub mod tradeoff;
@@ -66,6 +67,11 @@ pub enum Command {
     /// Path-trace a gem recipe to NAME.exr (colour, AOVs, metadata) and NAME.png. Ctrl-C or
     /// --time-limit stop early and write what was rendered, marked partial (Ctrl-C exits 130).
     Render(render::RenderArgs),
+    /// Author a recipe live in the browser: serves a page (on 127.0.0.1, with a token in its URL)
+    /// that refines the image progressively, re-renders when the recipe or a file it reads is
+    /// saved, shows errors over the last good image, and orbits, tilts, rocks and inspects the
+    /// stone. Runs until Ctrl-C.
+    Preview(preview::PreviewArgs),
     /// Merge part renders (`render --samples A..B`) into the render of the whole range: checks
     /// they belong together and cover every sample once; the result equals a one-machine
     /// render bit for bit.
@@ -95,6 +101,7 @@ pub fn run() -> ExitCode {
         Command::Info(args) => info::run(&args),
         Command::Tradeoff(args) => tradeoff::run(&args),
         Command::Merge(args) => merge::run(&args),
+        Command::Preview(args) => preview::run(&args),
         Command::Farm(args) => farm::run(&args),
         Command::Render(args) => match render::run(&args) {
             Ok(false) => Ok(()),

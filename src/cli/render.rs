@@ -68,6 +68,11 @@ pub struct RenderArgs {
     /// partial; nothing when not one pass completed).
     #[arg(long, allow_hyphen_values = true, value_parser = parse_seconds)]
     pub time_limit: Option<f64>,
+    /// Move the recipe's view without editing it: camera orbit and zoom about the stone, stone
+    /// tilt, light turn, as `lapidary preview` shows them (e.g. `yaw=30,pitch=-10,zoom=0.8,
+    /// tilt_x=5,light_yaw=90`; degrees; see docs/preview.md).
+    #[arg(long, allow_hyphen_values = true, value_parser = crate::scene::view::View::parse)]
+    pub view: Option<crate::scene::view::View>,
     /// PNG exposure in stops (default: the recipe's, else 0).
     #[arg(long, allow_hyphen_values = true, value_parser = parse_exposure)]
     pub exposure: Option<f32>,
@@ -156,7 +161,7 @@ pub(crate) fn parse_size(s: &str) -> Result<(u32, u32), String> {
     Ok((w, h))
 }
 
-fn parse_seconds(s: &str) -> Result<f64, String> {
+pub(crate) fn parse_seconds(s: &str) -> Result<f64, String> {
     match s.parse::<f64>() {
         Ok(v) if v > 0.0 && v <= 1e7 => Ok(v),
         _ => Err(format!("`{s}`: expected seconds in (0, 1e7]")),
@@ -242,6 +247,9 @@ fn settings(args: &RenderArgs, scene: &mut Scene) {
     if let Some(e) = args.exposure {
         r.exposure = e;
     }
+    if let Some(v) = &args.view {
+        v.apply(&mut scene.stage);
+    }
 }
 
 /// Runs `lapidary render`; returns whether the render was interrupted by Ctrl-C or SIGTERM
@@ -251,6 +259,13 @@ pub fn run(args: &RenderArgs) -> Result<bool> {
     // reset: a signal that arrives right after the handler is installed must not be lost.
     let cancel = interrupted();
     let started = Instant::now();
+    if args.samples.is_some() && args.view.as_ref().is_some_and(|v| !v.is_identity()) {
+        // A part's metadata does not record the view, so `merge` could not tell parts of two
+        // views apart: refused rather than merged wrongly.
+        bail!(
+            "--view with --samples: part renders do not record the view; render the whole image              with --view, or put the camera in the recipe for a farm render"
+        );
+    }
     let (exr_path, png_path) = outputs(args)?;
     let mut plan = OutputPlan::new();
     plan.input(&args.recipe, "the recipe")?;
@@ -291,6 +306,7 @@ pub fn run(args: &RenderArgs) -> Result<bool> {
         deadline,
         cancel: Some(cancel),
         progress: !args.quiet,
+        cache: None,
     };
     let world = match super::load::build_world(&args.recipe, &scene, &setup) {
         Ok(w) => w,

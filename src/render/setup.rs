@@ -57,6 +57,55 @@ pub struct Setup<'a> {
     /// Show a progress bar on standard error (only on a terminal) once building the material
     /// tables has taken more than [`PROGRESS_AFTER`].
     pub progress: bool,
+    /// Materials built by earlier worlds, reused when a stack is the same (`lapidary preview`
+    /// rebuilds the world on every save and keeps this cache: an edit rebuilds only the materials
+    /// it changed). `None`: every material is built.
+    pub cache: Option<&'a MaterialCache>,
+}
+
+/// Built materials by their description (a [`crate::bsdf::StackDesc`] with the effects that
+/// shape its build): a material's tables are a deterministic function of that key, so reusing
+/// one changes no result. Bounded: past [`MaterialCache::CAPACITY`] entries it starts afresh.
+#[derive(Debug, Default)]
+pub struct MaterialCache {
+    built:
+        std::sync::Mutex<std::collections::HashMap<String, (crate::bsdf::Bsdf, crate::color::Rgb)>>,
+    hits: std::sync::atomic::AtomicU64,
+    misses: std::sync::atomic::AtomicU64,
+}
+
+impl MaterialCache {
+    /// Most materials kept.
+    pub const CAPACITY: usize = 256;
+
+    /// The material stored under `key`, or `build`'s (stored unless it failed).
+    pub(crate) fn get_or_build<E>(
+        &self,
+        key: String,
+        build: impl FnOnce() -> Result<(crate::bsdf::Bsdf, crate::color::Rgb), E>,
+    ) -> Result<(crate::bsdf::Bsdf, crate::color::Rgb), E> {
+        if let Some(v) = self.built.lock().ok().and_then(|m| m.get(&key).cloned()) {
+            self.hits.fetch_add(1, Ordering::Relaxed);
+            return Ok(v);
+        }
+        self.misses.fetch_add(1, Ordering::Relaxed);
+        let v = build()?;
+        if let Ok(mut m) = self.built.lock() {
+            if m.len() >= Self::CAPACITY {
+                m.clear();
+            }
+            m.insert(key, v.clone());
+        }
+        Ok(v)
+    }
+
+    /// Materials taken from the cache and materials built through it, so far.
+    pub fn counts(&self) -> (u64, u64) {
+        (
+            self.hits.load(Ordering::Relaxed),
+            self.misses.load(Ordering::Relaxed),
+        )
+    }
 }
 
 /// How long table building runs before its progress bar appears.

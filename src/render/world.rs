@@ -5,7 +5,7 @@ mod inside;
 mod lights;
 mod materials;
 
-pub use super::setup::{PROGRESS_AFTER, Setup, WorldError};
+pub use super::setup::{MaterialCache, PROGRESS_AFTER, Setup, WorldError};
 use crate::bsdf::{Bsdf, Lambert};
 use crate::color::Rgb;
 use crate::geometry::{MediumId, Ray, Stone, StoneHit};

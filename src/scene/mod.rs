@@ -12,6 +12,7 @@ pub mod body;
 pub mod effects;
 pub mod stage;
 pub mod surface;
+pub mod view;
 
 pub use accuracy::{Accuracy, KnobError, Knobs};
 pub use body::{Body, Interior};

@@ -69,17 +69,28 @@ pub(super) fn build(
                 name: scene.surface.names[k].clone(),
                 source,
             };
-            let mut stack = LayeredBsdf::new(desc).map_err(material)?;
             let absorption = scene.effects.forced(Effect::Absorption);
-            stack.force_absorption(absorption);
-            if scene.effects.on(Effect::Spectral)
-                && let Some(l) = AlbedoLadder::build(desc, absorption).map_err(material)?
-            {
-                stack.set_albedo_ladder(l);
+            let spectral = scene.effects.on(Effect::Spectral);
+            let build = || {
+                let mut stack = LayeredBsdf::new(desc).map_err(material)?;
+                stack.force_absorption(absorption);
+                if spectral
+                    && let Some(l) = AlbedoLadder::build(desc, absorption).map_err(material)?
+                {
+                    stack.set_albedo_ladder(l);
+                }
+                let bsdf = Bsdf::from(stack);
+                let albedo = Rgb::from(normal_albedo(&bsdf));
+                Ok((bsdf, albedo))
+            };
+            match setup.cache {
+                // Everything the build reads: the stack, the absorption switch and whether the
+                // spectral ladder is built.
+                Some(cache) => cache
+                    .get_or_build(format!("{desc:?}|{absorption:?}|{spectral}"), build)
+                    .map(Some),
+                None => build().map(Some),
             }
-            let bsdf = Bsdf::from(stack);
-            let albedo = Rgb::from(normal_albedo(&bsdf));
-            Ok(Some((bsdf, albedo)))
         })
         .collect();
     bar.finish_and_clear();
@@ -117,13 +128,24 @@ pub(super) fn build(
                 Some(p) => &crate::render::prefilter::stack(p, desc),
                 None => desc,
             };
-            let mut stack = LayeredBsdf::new(desc).map_err(|source| WorldError::Material {
-                name: format!("platelet:{name}"),
-                source,
-            })?;
-            stack.force_absorption(scene.effects.forced(Effect::Absorption));
-            let bsdf = Bsdf::from(stack);
-            albedo.push(Rgb::from(normal_albedo(&bsdf)));
+            let absorption = scene.effects.forced(Effect::Absorption);
+            let build = || {
+                let mut stack = LayeredBsdf::new(desc).map_err(|source| WorldError::Material {
+                    name: format!("platelet:{name}"),
+                    source,
+                })?;
+                stack.force_absorption(absorption);
+                let bsdf = Bsdf::from(stack);
+                let a = Rgb::from(normal_albedo(&bsdf));
+                Ok::<_, WorldError>((bsdf, a))
+            };
+            let (bsdf, a) = match setup.cache {
+                Some(cache) => {
+                    cache.get_or_build(format!("platelet|{desc:?}|{absorption:?}"), build)?
+                }
+                None => build()?,
+            };
+            albedo.push(a);
             materials.push(Some(bsdf));
         }
     }

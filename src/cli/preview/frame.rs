@@ -1,0 +1,327 @@
+//! What the page asks of a published image: a PNG of the colour or of an AOV, the inspector's
+//! view of one pixel, and the export to EXR + PNG with the batch command that renders it again.
+
+use super::state::Image;
+use crate::image::{Curve, ToneMap};
+use crate::render::world::Hit;
+use crate::render::{CameraRays, Metadata, RenderStats, Rendered, exr_image};
+use crate::scene::Accuracy;
+use glam::{Vec2, Vec3};
+use serde_json::{Value, json};
+use std::path::{Path, PathBuf};
+
+/// The views of an image the page can show.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Aov {
+    /// Tone-mapped radiance.
+    Color,
+    /// First-hit albedo.
+    Albedo,
+    /// First-hit shading normal (`0.5 n + 0.5`).
+    Normal,
+    /// First-hit distance, near bright.
+    Depth,
+    /// First-hit material, one colour each.
+    Material,
+    /// The map's cells at the first hit (hashed colours).
+    Cells,
+    /// Relative standard error of each pixel's mean (viridis, 0 → 10 %).
+    Variance,
+}
+
+impl Aov {
+    /// Parses a query value.
+    pub fn parse(s: &str) -> Option<Aov> {
+        Some(match s {
+            "color" => Aov::Color,
+            "albedo" => Aov::Albedo,
+            "normal" => Aov::Normal,
+            "depth" => Aov::Depth,
+            "material" => Aov::Material,
+            "cells" => Aov::Cells,
+            "variance" => Aov::Variance,
+            _ => return None,
+        })
+    }
+}
+
+/// The image's PNG at the requested size (a quick low-resolution frame is enlarged, each pixel
+/// a block).
+pub fn png(image: &Image, aov: Aov, tm: &ToneMap) -> Vec<u8> {
+    let film = &image.film;
+    let (w, h) = (film.width, film.height);
+    let max_depth = film
+        .pixels
+        .iter()
+        .map(|p| p.mean_depth())
+        .fold(0.0f32, f32::max)
+        .max(1e-6);
+    let cells = (aov == Aov::Cells).then(|| cell_ids(image));
+    let pixel = |i: usize| -> [u8; 3] {
+        let p = &film.pixels[i];
+        let unit = |v: [f32; 3]| v.map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8);
+        match aov {
+            Aov::Color => crate::image::tone_map_pixel(p.mean().0, tm),
+            Aov::Albedo => crate::image::tone_map_pixel(
+                p.mean_albedo(),
+                &ToneMap {
+                    exposure: 0.0,
+                    curve: Curve::Clamp,
+                },
+            ),
+            Aov::Normal => unit(p.mean_normal().map(|c| 0.5 * c + 0.5)),
+            Aov::Depth => {
+                let d = p.mean_depth();
+                let v = if d > 0.0 { 1.0 - d / max_depth } else { 0.0 };
+                unit([v; 3])
+            }
+            Aov::Material => match usize::try_from(p.material) {
+                Ok(m) => crate::cli::map::palette(m),
+                Err(_) => [24, 24, 24],
+            },
+            Aov::Cells => match cells.as_ref().and_then(|c| c[i]) {
+                Some(id) => {
+                    let h = crate::sampler::mix64(id);
+                    [
+                        (h >> 8) as u8 | 0x30,
+                        (h >> 24) as u8 | 0x30,
+                        (h >> 40) as u8 | 0x30,
+                    ]
+                }
+                None => [24, 24, 24],
+            },
+            Aov::Variance => {
+                let m = p.mean().0;
+                let v = p.variance_of_mean();
+                let lum = |c: [f32; 3]| 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+                let rel = lum(v.map(f32::sqrt)) / lum(m).max(1e-6);
+                crate::image::heatmap::viridis((rel / 0.1).clamp(0.0, 1.0))
+            }
+        }
+    };
+    let s = image.scale.max(1);
+    let (ow, oh) = (w * s, h * s);
+    let mut bytes = Vec::with_capacity(3 * (ow * oh) as usize);
+    for y in 0..oh {
+        for x in 0..ow {
+            bytes.extend_from_slice(&pixel(((y / s) * w + x / s) as usize));
+        }
+    }
+    let mut out = Vec::new();
+    // Encoding into memory fails only on a size mismatch, which the loops above rule out.
+    let _ = crate::image::png::encode_rgb8(&mut out, ow, oh, &bytes);
+    out
+}
+
+/// The camera ray through the centre of film pixel `(x, y)` of `image`.
+fn primary_hit(image: &Image, x: u32, y: u32) -> (Option<Hit>, Vec3) {
+    let r = &image.scene.stage.render;
+    let (w, h) = (image.film.width, image.film.height);
+    let _ = r;
+    let rays = CameraRays::new(&image.scene.stage.camera, w, h, false);
+    let ray = rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5), Vec2::splat(0.5));
+    (image.world.intersect(&ray, f32::INFINITY), ray.dir)
+}
+
+/// The map's cell trail hash at the first hit of every film pixel (`None`: not the stone).
+fn cell_ids(image: &Image) -> Vec<Option<u64>> {
+    let (w, h) = (image.film.width, image.film.height);
+    (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .map(|(x, y)| match primary_hit(image, x, y).0 {
+            Some(Hit::Stone(s)) => Some(image.world.map.lookup(s.p_object, 0.5).trail.hash()),
+            _ => None,
+        })
+        .collect()
+}
+
+/// The inspector's JSON for requested-image pixel `(x, y)`; `None` outside the image.
+pub fn inspect(image: &Image, x: u32, y: u32) -> Option<Value> {
+    let s = image.scale.max(1);
+    let (fx, fy) = (x / s, y / s);
+    if fx >= image.film.width || fy >= image.film.height {
+        return None;
+    }
+    let p = &image.film.pixels[(fy * image.film.width + fx) as usize];
+    let sigma = p.variance_of_mean().map(f32::sqrt);
+    let (hit, dir) = primary_hit(image, fx, fy);
+    let mut out = json!({
+        "x": x, "y": y,
+        "radiance": p.mean().0, "sigma": sigma, "spp": p.n,
+        "albedo": p.mean_albedo(),
+        "depth": (p.depth_n > 0).then(|| p.mean_depth()),
+        "hit": "sky", "point": null, "normal": null, "facet_normal": null,
+        "material": null, "cells": [], "glitter_cell": null,
+    });
+    match hit {
+        Some(Hit::Stone(h)) => {
+            let look = image.world.map.lookup(h.p_object, 0.5);
+            let m = look.material as usize;
+            let surface = &image.scene.surface;
+            let model = surface
+                .stacks
+                .get(m)
+                .map(|d| {
+                    let mut t = format!("{d:?}");
+                    if t.len() > 600 {
+                        let cut = (0..=600)
+                            .rev()
+                            .find(|&i| t.is_char_boundary(i))
+                            .unwrap_or(0);
+                        t.truncate(cut);
+                        t.push('…');
+                    }
+                    t
+                })
+                .unwrap_or_else(|| "the translucent body's boundary".into());
+            out["hit"] = json!("stone");
+            out["point"] = json!(h.p.to_array());
+            out["normal"] = json!(h.ns.to_array());
+            out["facet_normal"] = json!(look.facet.map(|f| f.to_array()));
+            out["material"] = json!({
+                "index": look.material,
+                "name": surface.names.get(m).cloned().unwrap_or_else(|| "body".into()),
+                "model": model,
+            });
+            out["cells"] = json!(
+                look.trail
+                    .ids()
+                    .iter()
+                    .map(|c| format!("{c:016x}"))
+                    .collect::<Vec<_>>()
+            );
+            out["glitter_cell"] = json!(look.trail.glitter_cell().map(|c| format!("{c:016x}")));
+        }
+        Some(Hit::Ground { p, .. }) => {
+            out["hit"] = json!("ground");
+            out["point"] = json!(p.to_array());
+            out["normal"] = json!(if dir.y <= 0.0 {
+                [0.0, 1.0, 0.0]
+            } else {
+                [0.0, -1.0, 0.0]
+            });
+        }
+        Some(Hit::Light { index, .. }) => {
+            out["hit"] = json!(format!("light {index}"));
+        }
+        Some(Hit::Platelet { p, material, .. }) => {
+            out["hit"] = json!("platelet");
+            out["point"] = json!(p.to_array());
+            out["material"] = json!({ "index": material, "name": "platelet", "model": "" });
+        }
+        None => {}
+    }
+    Some(out)
+}
+
+/// The batch command that renders `image` again (the same pixels once it has `spp` samples).
+pub fn command(recipe: &Path, image: &Image, knobs: &Accuracy, out: Option<&Path>) -> String {
+    let r = &image.scene.stage.render;
+    let mut cmd = format!(
+        "lapidary render {} --size {}x{} --spp {}",
+        shell_quote(&recipe.display().to_string()),
+        r.width,
+        r.height,
+        image.spp
+    );
+    if let Some(v) = image.view.to_arg() {
+        cmd += &format!(" --view {v}");
+    }
+    cmd += &knob_flags(knobs);
+    if let Some(o) = out {
+        cmd += &format!(" --output {}", shell_quote(&o.display().to_string()));
+    }
+    cmd
+}
+
+/// The command-line flags of `knobs` (each as `render` reads it).
+fn knob_flags(k: &Accuracy) -> String {
+    let onoff = |b: bool| if b { "on" } else { "off" };
+    let mut out = String::new();
+    if let Some(m) = k.model {
+        out += &format!(" --model {m}");
+    }
+    if let Some(f) = k.fresnel {
+        out += &format!(" --fresnel {f}");
+    }
+    if let Some(d) = k.distribution {
+        out += &format!(" --distribution {d}");
+    }
+    if let Some(m) = k.masking {
+        out += &format!(" --masking {m}");
+    }
+    if let Some(c) = k.compensation {
+        out += &format!(" --compensation {}", onoff(c));
+    }
+    if let Some(c) = k.calibration {
+        out += &format!(" --calibration {}", onoff(c));
+    }
+    for (e, on) in &k.effects {
+        out += &format!(" --effect {}={}", e.name(), onoff(*on));
+    }
+    out
+}
+
+fn shell_quote(s: &str) -> String {
+    if !s.is_empty()
+        && s.chars()
+            .all(|c| c.is_ascii_alphanumeric() || "-_./+=:,@".contains(c))
+    {
+        s.to_string()
+    } else {
+        format!("'{}'", s.replace('\'', r"'\''"))
+    }
+}
+
+/// Writes `image` as `<stem>-preview.exr` and `.png` in `dir` (all or nothing; refused when a
+/// name is one of `inputs`) and returns the paths and the batch command.
+pub fn export(
+    recipe: &Path,
+    image: &Image,
+    inputs: &[PathBuf],
+    dir: &Path,
+    tm: &ToneMap,
+) -> anyhow::Result<Value> {
+    use crate::image::outputs::{Format, OutputPlan};
+    anyhow::ensure!(
+        image.scale == 1,
+        "the image is still at its quick first resolution: wait for the first full pass"
+    );
+    let stem = recipe
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "preview".into());
+    let mut plan = OutputPlan::new();
+    for i in inputs {
+        plan.input(i, "an input of the recipe")?;
+    }
+    let exr_path = dir.join(format!("{stem}-preview.exr"));
+    let png_path = dir.join(format!("{stem}-preview.png"));
+    let exr = plan.output(&exr_path, Format::Exr)?;
+    let png = plan.output(&png_path, Format::Png)?;
+    let rendered = Rendered {
+        film: image.film.clone(),
+        stats: RenderStats {
+            elapsed: std::time::Duration::ZERO,
+            paths: image.film.samples() + image.film.dropped(),
+            rays: image.film.rays(),
+            dropped: image.film.dropped(),
+            partial: false,
+            spp_complete: image.spp,
+        },
+    };
+    let mut scene = (*image.scene).clone();
+    scene.stage.render.spp = image.spp;
+    let meta = Metadata::of(&recipe.display().to_string(), &scene);
+    let (w, h) = (image.film.width, image.film.height);
+    crate::image::atomic::all_or_nothing(|| {
+        crate::image::write_exr(&exr, &exr_image(&rendered, &meta))?;
+        crate::image::write_png(&png, w, h, &rendered.film.rgb(), tm)?;
+        Ok(())
+    })?;
+    Ok(json!({
+        "exr": exr_path.display().to_string(),
+        "png": png_path.display().to_string(),
+        "command": command(recipe, image, &image.knobs, Some(&exr_path)),
+    }))
+}

@@ -1,0 +1,218 @@
+//! How one generation of the preview is rendered: a quick quarter-resolution frame, then sample
+//! ranges that merge exactly into one film until the budget (or the rock motion's frames), each
+//! published as it completes; the worker pauses while no page asks.
+
+use super::state::{Image, Phase, ROCK_AMPLITUDE, ROCK_PERIOD, Request, Shared};
+use crate::render::world::Setup;
+use crate::render::{Control, Film, World, render};
+use crate::scene::view::{MAX_TILT, View};
+use crate::scene::{Accuracy, Scene};
+use std::sync::Arc;
+use std::sync::atomic::Ordering;
+use std::time::{Duration, Instant};
+
+/// Renders samples `range` of `scene` at `1/scale` of its size; `None` when stopped part way.
+fn render_range(
+    shared: &Shared,
+    world: &World,
+    scene: &Scene,
+    range: std::ops::Range<u32>,
+    scale: u32,
+) -> Option<(Film, u64, f64)> {
+    let mut settings = scene.stage.render;
+    settings.width = settings.width.div_ceil(scale).max(1);
+    settings.height = settings.height.div_ceil(scale).max(1);
+    let control = Control {
+        threads: shared.threads,
+        cancel: Some(&shared.restart),
+        samples: Some(range),
+        ..Control::default()
+    };
+    let r = render(
+        world,
+        &scene.stage.camera,
+        scene.effects.on(crate::scene::Effect::DepthOfField),
+        &settings,
+        &control,
+    );
+    (!r.stats.partial).then_some((r.film, r.stats.paths, r.stats.elapsed.as_secs_f64()))
+}
+
+/// Refines the image of one generation until its budget or a change.
+pub(super) fn refine(
+    shared: &Shared,
+    scene: Arc<Scene>,
+    world: Arc<World>,
+    view: View,
+    knobs: &Accuracy,
+) {
+    let (w, h) = (scene.stage.render.width, scene.stage.render.height);
+    let budget = scene.stage.render.spp;
+    // A quick quarter-resolution frame first (a sixteenth of one pass), unless the image is
+    // small already.
+    if w >= 160 && h >= 120 {
+        let Some((film, paths, secs)) = render_range(shared, &world, &scene, 0..1, 4) else {
+            return;
+        };
+        publish_image(
+            shared,
+            (&scene, &world, view, knobs),
+            film,
+            1,
+            4,
+            paths,
+            secs,
+        );
+    }
+    let mut film = Film::new(w, h);
+    let mut done = 0u32;
+    let mut rate = 0.0f64; // pixel samples per second
+    let seconds = shared.lock().request.seconds;
+    let mut spent = 0.0f64;
+    while done < budget && seconds.is_none_or(|b| spent < b) {
+        if shared.restart.load(Ordering::SeqCst) || !wait_for_a_client(shared) {
+            return;
+        }
+        // Ranges of about a third of a second once the rate is known (1 spp first).
+        let pixels = f64::from(w) * f64::from(h);
+        let want = if rate > 0.0 {
+            (rate * 0.33 / pixels).floor().clamp(1.0, 256.0) as u32
+        } else {
+            1
+        };
+        let end = done.saturating_add(want).min(budget);
+        let Some((part, paths, secs)) = render_range(shared, &world, &scene, done..end, 1) else {
+            return;
+        };
+        for (acc, p) in film.pixels.iter_mut().zip(&part.pixels) {
+            acc.merge(p);
+        }
+        rate = paths as f64 / secs.max(1e-6);
+        spent += secs;
+        done = end;
+        publish_image(
+            shared,
+            (&scene, &world, view, knobs),
+            film.clone(),
+            done,
+            1,
+            paths,
+            secs,
+        );
+    }
+    let s = shared.lock();
+    shared.publish(s, |s| s.phase = Phase::Done);
+}
+
+/// Pauses while no page has asked for anything for [`Shared::idle`]; `false` when a change
+/// or quit ends the wait.
+fn wait_for_a_client(shared: &Shared) -> bool {
+    let mut s = shared.lock();
+    if s.last_client.elapsed() < shared.idle {
+        return true;
+    }
+    let resume = s.phase;
+    s.phase = Phase::Paused;
+    shared.publish(s, |_| {});
+    let mut s = shared.lock();
+    while s.last_client.elapsed() >= shared.idle {
+        if s.quit || shared.restart.load(Ordering::SeqCst) {
+            return false;
+        }
+        s = match shared.wake.wait_timeout(s, Duration::from_millis(500)) {
+            Ok((g, _)) => g,
+            Err(p) => p.into_inner().0,
+        };
+    }
+    s.phase = resume;
+    true
+}
+
+/// Publishes an image.
+fn publish_image(
+    shared: &Shared,
+    (scene, world, view, knobs): (&Arc<Scene>, &Arc<World>, View, &Accuracy),
+    film: Film,
+    spp: u32,
+    scale: u32,
+    paths: u64,
+    secs: f64,
+) {
+    let image = Arc::new(Image {
+        film,
+        spp,
+        scale,
+        world: Arc::clone(world),
+        scene: Arc::clone(scene),
+        view,
+        knobs: knobs.clone(),
+    });
+    let s = shared.lock();
+    shared.publish(s, |s| {
+        if s.first_pixels.is_none() {
+            s.first_pixels = Some(s.generation_start.elapsed().as_secs_f64());
+        }
+        s.paths_per_second = paths as f64 / secs.max(1e-9);
+        s.render_seconds += secs;
+        s.image = Some(image);
+    });
+}
+
+/// Shows the stone rocking: frames at half resolution, 2 spp, each at the tilt of its moment,
+/// until the request changes.
+pub(super) fn rock(shared: &Shared, base: &Scene, request: Request, knobs: &Accuracy) {
+    let start = Instant::now();
+    shared.lock().phase = Phase::Rocking;
+    while !shared.restart.load(Ordering::SeqCst) {
+        if !wait_for_a_client(shared) {
+            return;
+        }
+        let t = start.elapsed().as_secs_f64();
+        let swing = (std::f64::consts::TAU * t / ROCK_PERIOD).sin() as f32;
+        let mut view = request.view;
+        view.tilt_x = (view.tilt_x + ROCK_AMPLITUDE * swing).clamp(-MAX_TILT, MAX_TILT);
+        let mut scene = base.clone();
+        view.apply(&mut scene.stage);
+        let world = match build(shared, &scene) {
+            Ok(w) => Arc::new(w),
+            Err(Some(message)) => {
+                let s = shared.lock();
+                shared.publish(s, |s| {
+                    s.phase = Phase::Error;
+                    s.error = Some(message);
+                });
+                return;
+            }
+            Err(None) => return,
+        };
+        let scene = Arc::new(scene);
+        let Some((film, paths, secs)) = render_range(shared, &world, &scene, 0..2, 2) else {
+            return;
+        };
+        publish_image(
+            shared,
+            (&scene, &world, view, knobs),
+            film,
+            2,
+            2,
+            paths,
+            secs,
+        );
+        shared.lock().phase = Phase::Rocking;
+    }
+}
+
+/// Builds the world of `scene`; `Err(None)` when stopped by a newer request.
+pub(super) fn build(shared: &Shared, scene: &Scene) -> Result<World, Option<String>> {
+    let setup = Setup {
+        deadline: None,
+        cancel: Some(&shared.restart),
+        progress: false,
+        cache: Some(&shared.cache),
+    };
+    match crate::cli::load::build_world(&shared.recipe, scene, &setup) {
+        Ok(w) => Ok(w),
+        Err(e) if e.stopped() => Err(None),
+        Err(e) => Err(Some(format!("error: {e}"))),
+    }
+}
