@@ -11,6 +11,7 @@
 //! the export), `page.html` (the page, compiled in).
 
 pub mod frame;
+pub mod http;
 pub mod progressive;
 pub mod server;
 pub mod session;
@@ -77,17 +78,15 @@ pub struct Running {
     pub url: String,
     /// The session.
     pub shared: Arc<Shared>,
-    server: Arc<tiny_http::Server>,
+    server: http::Server,
     threads: Vec<std::thread::JoinHandle<()>>,
 }
 
 impl Running {
     /// Stops the worker and the handlers and waits for them.
     pub fn stop(self) {
+        self.server.stop();
         self.shared.quit();
-        for _ in 0..server::HANDLERS {
-            self.server.unblock();
-        }
         for t in self.threads {
             let _ = t.join();
         }
@@ -110,13 +109,9 @@ pub fn start(args: &PreviewArgs) -> Result<Running> {
              learns its URL (with the token) can use it"
         );
     }
-    let server = tiny_http::Server::http(SocketAddr::new(ip, args.port))
-        .map_err(|e| anyhow::anyhow!("cannot listen on {ip}:{}: {e} (try --port 0)", args.port))?;
-    let port = server
-        .server_addr()
-        .to_ip()
-        .map(|a| a.port())
-        .unwrap_or(args.port);
+    let listener = std::net::TcpListener::bind(SocketAddr::new(ip, args.port))
+        .with_context(|| format!("cannot listen on {ip}:{} (try --port 0)", args.port))?;
+    let port = listener.local_addr()?.port();
     let token = server::token().context("no random token from the operating system")?;
     let host = match ip {
         IpAddr::V6(v6) => format!("[{v6}]:{port}"),
@@ -144,7 +139,6 @@ pub fn start(args: &PreviewArgs) -> Result<Running> {
     if let Ok(mut w) = shared.watcher.lock() {
         *w = watch_inputs(&shared);
     }
-    let server = Arc::new(server);
     let ctx = Arc::new(server::Context {
         shared: Arc::clone(&shared),
         token: token.clone(),
@@ -174,20 +168,16 @@ pub fn start(args: &PreviewArgs) -> Result<Running> {
             tev::stream(&shared, addr, &name)
         }));
     }
-    for _ in 0..server::HANDLERS {
-        let (server, ctx) = (Arc::clone(&server), Arc::clone(&ctx));
-        threads.push(std::thread::spawn(move || {
-            while let Ok(req) = server.recv() {
-                if ctx.shared.lock().quit {
-                    break;
-                }
-                // A panic in one request must not take the server down.
-                let _ = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                    server::handle(&ctx, req)
-                }));
-            }
-        }));
-    }
+    let handler = move |req: http::Request| {
+        // A panic in one request must not take the server down.
+        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| server::handle(&ctx, &req)))
+            .unwrap_or_else(|_| http::Response {
+                status: 500,
+                headers: vec![],
+                body: b"internal error".to_vec(),
+            })
+    };
+    let server = http::Server::start(listener, Arc::new(handler))?;
     Ok(Running {
         url: format!("http://{host}/?t={token}"),
         shared,

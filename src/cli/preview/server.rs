@@ -1,31 +1,26 @@
-//! The preview's HTTP server (`tiny_http`, blocking, a few handler threads): the page, the
-//! session's status as a long poll, images, the inspector, view changes and the export.
+//! The preview's HTTP routes (served by [`super::http`], a thread per connection): the page, the
+//! session's status as a long poll, images, the inspector, view and knob changes and the export.
 //!
 //! **Safe to leave running.** Every request must carry the session's random token (`t=`, 128
 //! bits from the operating system); its `Host` must be the server's own address (a DNS-rebinding
 //! page reaches the server under a foreign host name) and its `Origin`, when the browser sends
 //! one, the server's own origin. No request names a file: the routes are fixed and the page is
-//! compiled in. Request bodies are capped at [`MAX_BODY`] bytes, long polls at [`LONG_POLL`], and
-//! the handler threads at [`HANDLERS`], so nothing a client sends can hold the server.
+//! compiled in. Connections, request heads and bodies are capped ([`super::http`]) and long polls
+//! last at most [`LONG_POLL`], so nothing a client sends can hold the server.
 
 use super::frame::{self, Aov};
+use super::http::{Request, Response};
 use super::state::{MAX_PIXELS, MAX_SPP, Shared};
 use crate::image::{Curve, ToneMap};
 use serde_json::{Value, json};
-use std::io::Read;
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Duration;
-use tiny_http::{Header, Method, Request, Response};
 
 /// The page, compiled in.
 pub const PAGE: &str = include_str!("page.html");
-/// Largest request body read (bytes).
-pub const MAX_BODY: usize = 16 * 1024;
 /// Longest a status request waits for a new frame.
 pub const LONG_POLL: Duration = Duration::from_secs(10);
-/// Handler threads (long polls hold one each while they wait).
-pub const HANDLERS: usize = 8;
 
 /// What a handler needs besides the request.
 pub struct Context {
@@ -48,22 +43,21 @@ pub fn token() -> std::io::Result<String> {
     Ok(b.iter().map(|x| format!("{x:02x}")).collect())
 }
 
-fn header(name: &str, value: &str) -> Header {
-    // Names and values here are ASCII constants or ASCII built from them.
-    Header::from_bytes(name.as_bytes(), value.as_bytes())
-        .unwrap_or_else(|_| Header::from_bytes(&b"X-Invalid"[..], &b"1"[..]).expect("ASCII"))
-}
-
-type Reply = Response<std::io::Cursor<Vec<u8>>>;
+type Reply = Response;
 
 fn reply(status: u16, content_type: &str, body: Vec<u8>) -> Reply {
-    Response::from_data(body)
-        .with_status_code(status)
-        .with_header(header("Content-Type", content_type))
-        .with_header(header("Cache-Control", "no-store"))
-        .with_header(header("X-Content-Type-Options", "nosniff"))
-        .with_header(header("Referrer-Policy", "no-referrer"))
-        .with_header(header("X-Frame-Options", "DENY"))
+    let h = |k: &str, v: &str| (k.to_string(), v.to_string());
+    Response {
+        status,
+        headers: vec![
+            h("Content-Type", content_type),
+            h("Cache-Control", "no-store"),
+            h("X-Content-Type-Options", "nosniff"),
+            h("Referrer-Policy", "no-referrer"),
+            h("X-Frame-Options", "DENY"),
+        ],
+        body,
+    }
 }
 
 fn json_reply(status: u16, v: &Value) -> Reply {
@@ -124,12 +118,7 @@ fn same(a: &str, b: &str) -> bool {
 
 /// Why a request is refused before routing, if it is.
 fn refuse(ctx: &Context, req: &Request, query: &[(String, String)]) -> Option<Reply> {
-    let get = |name: &'static str| {
-        req.headers()
-            .iter()
-            .find(|h| h.field.equiv(name))
-            .map(|h| h.value.as_str().to_string())
-    };
+    let get = |name: &str| req.header(name).map(str::to_string);
     match get("Host") {
         Some(h) if ctx.hosts.iter().any(|a| a.eq_ignore_ascii_case(&h)) => {}
         _ => {
@@ -174,60 +163,34 @@ fn text<'a>(query: &'a [(String, String)], name: &str) -> Option<&'a str> {
         .map(|(_, v)| v.as_str())
 }
 
-/// Serves one request (never panics out: the caller catches panics too).
-pub fn handle(ctx: &Context, mut req: Request) {
-    let url = req.url().to_string();
-    let (path, query) = split_url(&url);
-    let response = match refuse(ctx, &req, &query) {
-        Some(r) => r,
-        None => {
-            ctx.shared.client_seen();
-            let method = req.method().clone();
-            match (method, path) {
-                (Method::Get, "/") => reply(200, "text/html; charset=utf-8", PAGE.into())
-                    .with_header(header(
-                        "Content-Security-Policy",
-                        "default-src 'self'; script-src 'unsafe-inline'; style-src \
-                         'unsafe-inline'; img-src 'self' blob: data:; connect-src 'self'; \
-                         frame-ancestors 'none'",
-                    )),
-                (Method::Get, "/status") => status(ctx, &query),
-                (Method::Get, "/frame.png") => frame_png(ctx, &query),
-                (Method::Get, "/inspect") => inspect(ctx, &query),
-                (Method::Post, "/view") => match body(&mut req) {
-                    Ok(b) => view(ctx, &b),
-                    Err(r) => r,
-                },
-                (Method::Post, "/export") => export(ctx, &query),
-                (Method::Post, "/knobs") => match body(&mut req) {
-                    Ok(b) => knobs(ctx, &b),
-                    Err(r) => r,
-                },
-                (
-                    _,
-                    "/" | "/status" | "/frame.png" | "/inspect" | "/view" | "/export" | "/knobs",
-                ) => error(405, "method not allowed"),
-                _ => error(404, "no such page"),
-            }
-        }
-    };
-    let _ = req.respond(response);
-}
-
-/// The request's body, at most [`MAX_BODY`] bytes.
-fn body(req: &mut Request) -> Result<Vec<u8>, Reply> {
-    if req.body_length().is_some_and(|n| n > MAX_BODY) {
-        return Err(error(413, format!("body over {MAX_BODY} bytes")));
+/// Answers one request.
+pub fn handle(ctx: &Context, req: &Request) -> Reply {
+    let (path, query) = split_url(&req.target);
+    if let Some(r) = refuse(ctx, req, &query) {
+        return r;
     }
-    let mut b = Vec::new();
-    let r = req
-        .as_reader()
-        .take(MAX_BODY as u64 + 1)
-        .read_to_end(&mut b);
-    match r {
-        Ok(_) if b.len() > MAX_BODY => Err(error(413, format!("body over {MAX_BODY} bytes"))),
-        Ok(_) => Ok(b),
-        Err(e) => Err(error(400, format!("reading the body: {e}"))),
+    ctx.shared.client_seen();
+    match (req.method.as_str(), path) {
+        ("GET", "/") => {
+            let mut r = reply(200, "text/html; charset=utf-8", PAGE.into());
+            r.headers.push((
+                "Content-Security-Policy".into(),
+                "default-src 'self'; script-src 'unsafe-inline'; style-src 'unsafe-inline'; \
+                 img-src 'self' blob: data:; connect-src 'self'; frame-ancestors 'none'"
+                    .into(),
+            ));
+            r
+        }
+        ("GET", "/status") => status(ctx, &query),
+        ("GET", "/frame.png") => frame_png(ctx, &query),
+        ("GET", "/inspect") => inspect(ctx, &query),
+        ("POST", "/view") => view(ctx, &req.body),
+        ("POST", "/knobs") => knobs(ctx, &req.body),
+        ("POST", "/export") => export(ctx, &query),
+        (_, "/" | "/status" | "/frame.png" | "/inspect" | "/view" | "/export" | "/knobs") => {
+            error(405, "method not allowed")
+        }
+        _ => error(404, "no such page"),
     }
 }
 
