@@ -113,6 +113,32 @@ fn refuses_requests_without_its_token_host_or_origin() {
     drop(idle);
     std::thread::sleep(Duration::from_millis(300));
     assert_eq!(code("GET", &ok, &[("Host", &host)]), 200);
+    // Long polls of clients that went away (closed or reloaded tabs) free their connections
+    // within a second, not at the end of the 10 s poll.
+    let polls: Vec<std::net::TcpStream> = (0..40)
+        .map(|_| {
+            let mut c = std::net::TcpStream::connect(("127.0.0.1", p.port)).unwrap();
+            let req = format!(
+                "GET /status?since=999999999&t={} HTTP/1.1\r\nHost: {host}\r\n\r\n",
+                p.token
+            );
+            std::io::Write::write_all(&mut c, req.as_bytes()).unwrap();
+            c
+        })
+        .collect();
+    std::thread::sleep(Duration::from_millis(300));
+    assert_eq!(
+        code("GET", &ok, &[("Host", &host)]),
+        503,
+        "32 long polls hold the slots"
+    );
+    drop(polls);
+    std::thread::sleep(Duration::from_millis(1000));
+    assert_eq!(
+        code("GET", &ok, &[("Host", &host)]),
+        200,
+        "their slots are free again"
+    );
     // The page: compiled in, nothing fetched from elsewhere (its policy forbids it too).
     let page = p.get("/");
     assert_eq!(page.status, 200);

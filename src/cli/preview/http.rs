@@ -26,7 +26,7 @@ pub const MAX_BODY: usize = 16 * 1024;
 pub const READ_TIMEOUT: Duration = Duration::from_secs(10);
 
 /// A request as read.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug)]
 pub struct Request {
     /// `GET`, `POST`, …
     pub method: String,
@@ -36,6 +36,9 @@ pub struct Request {
     pub headers: Vec<(String, String)>,
     /// The body (at most [`MAX_BODY`] bytes).
     pub body: Vec<u8>,
+    /// The connection, to notice a client that went away while its request waits (a long poll
+    /// of a closed tab must not hold its connection slot for the whole poll).
+    pub conn: Option<TcpStream>,
 }
 
 impl Request {
@@ -45,6 +48,22 @@ impl Request {
             .iter()
             .find(|(k, _)| k.eq_ignore_ascii_case(name))
             .map(|(_, v)| v.as_str())
+    }
+
+    /// Whether the client closed its side of the connection (it can no longer read an answer).
+    pub fn client_gone(&self) -> bool {
+        let Some(c) = &self.conn else { return false };
+        if c.set_nonblocking(true).is_err() {
+            return false;
+        }
+        let mut b = [0u8; 1];
+        let gone = match c.peek(&mut b) {
+            Ok(0) => true,
+            Ok(_) => false,
+            Err(e) => e.kind() != std::io::ErrorKind::WouldBlock,
+        };
+        let _ = c.set_nonblocking(false);
+        gone
     }
 }
 
@@ -144,6 +163,7 @@ fn read_request(stream: &TcpStream) -> Result<Request, Response> {
         target,
         headers,
         body: Vec::new(),
+        conn: stream.try_clone().ok(),
     };
     if req
         .header("Transfer-Encoding")

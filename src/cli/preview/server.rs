@@ -181,7 +181,7 @@ pub fn handle(ctx: &Context, req: &Request) -> Reply {
             ));
             r
         }
-        ("GET", "/status") => status(ctx, &query),
+        ("GET", "/status") => status(ctx, req, &query),
         ("GET", "/frame.png") => frame_png(ctx, &query),
         ("GET", "/inspect") => inspect(ctx, &query),
         ("POST", "/view") => view(ctx, &req.body),
@@ -242,12 +242,25 @@ pub fn status_json(ctx: &Context, s: &super::state::State) -> Value {
     })
 }
 
-fn status(ctx: &Context, query: &[(String, String)]) -> Reply {
-    let s = match number::<u64>(query, "since") {
-        Some(since) => ctx.shared.wait_newer(since, LONG_POLL),
-        None => ctx.shared.lock(),
+fn status(ctx: &Context, req: &Request, query: &[(String, String)]) -> Reply {
+    let Some(since) = number::<u64>(query, "since") else {
+        return json_reply(200, &status_json(ctx, &ctx.shared.lock()));
     };
-    json_reply(200, &status_json(ctx, &s))
+    // Waits in short slices, giving up when the client has gone (a reloaded or closed tab).
+    let deadline = std::time::Instant::now() + LONG_POLL;
+    loop {
+        let left = deadline.saturating_duration_since(std::time::Instant::now());
+        let s = ctx
+            .shared
+            .wait_newer(since, left.min(Duration::from_millis(250)));
+        if s.frame > since || s.quit || left.is_zero() {
+            return json_reply(200, &status_json(ctx, &s));
+        }
+        drop(s);
+        if req.client_gone() {
+            return error(400, "the client went away");
+        }
+    }
 }
 
 fn tone_map(query: &[(String, String)]) -> Result<ToneMap, Reply> {
