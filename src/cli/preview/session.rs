@@ -102,6 +102,15 @@ fn generation(shared: &Shared, loaded: &mut Option<Loaded>, request: Request, re
                 let mut s = shared.lock();
                 let before = std::mem::replace(&mut s.inputs, inputs);
                 s.error = None;
+                // An event that arrived while the files were read, for what was read: nothing
+                // new to reload (the files are as their new stamps say), and unless the page
+                // changed the request too, nothing to restart.
+                if s.reload && !s.inputs.differ_on_disk() {
+                    s.reload = false;
+                    if s.request == request {
+                        shared.restart.store(false, Ordering::SeqCst);
+                    }
+                }
                 if let Ok(mut w) = shared.watcher.lock()
                     && let Some(w) = w.as_mut()
                 {

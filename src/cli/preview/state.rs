@@ -248,6 +248,10 @@ impl Shared {
     /// Marks the recipe's files changed (the watcher calls it).
     pub fn files_changed(&self) {
         let mut s = self.lock();
+        // A late event for a save the worker has read already (its stamps are the file's now).
+        if !s.inputs.differ_on_disk() {
+            return;
+        }
         s.reload = true;
         s.last_change = Instant::now();
         self.restart.store(true, Ordering::SeqCst);

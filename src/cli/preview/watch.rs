@@ -79,6 +79,11 @@ impl Inputs {
         changed
     }
 
+    /// Whether any file differs from its stamp now (the stamps are left as they are).
+    pub fn differ_on_disk(&self) -> bool {
+        self.files.iter().any(|f| stamp(&f.path) != f.seen)
+    }
+
     /// Whether `path` (as an event reports it) is one of the files.
     pub fn contains(&self, path: &Path) -> bool {
         let name = path.file_name();
