@@ -50,19 +50,8 @@ pub(super) fn refine(
     let budget = scene.stage.render.spp;
     // A quick quarter-resolution frame first (a sixteenth of one pass), unless the image is
     // small already.
-    if w >= 160 && h >= 120 {
-        let Some((film, paths, secs)) = render_range(shared, &world, &scene, 0..1, 4) else {
-            return;
-        };
-        publish_image(
-            shared,
-            (&scene, &world, view, knobs),
-            film,
-            1,
-            4,
-            paths,
-            secs,
-        );
+    if w >= 160 && h >= 120 && !quick_frame(shared, (&scene, &world, view, knobs), 1, 4) {
+        return;
     }
     let mut film = Film::new(w, h);
     let mut done = 0u32;
@@ -128,6 +117,20 @@ fn wait_for_a_client(shared: &Shared) -> bool {
     true
 }
 
+/// Renders samples `0..spp` at `1/scale` of the size and publishes them; `false` when stopped.
+fn quick_frame(
+    shared: &Shared,
+    what: (&Arc<Scene>, &Arc<World>, View, &Accuracy),
+    spp: u32,
+    scale: u32,
+) -> bool {
+    let Some((film, paths, secs)) = render_range(shared, what.1, what.0, 0..spp, scale) else {
+        return false;
+    };
+    publish_image(shared, what, film, spp, scale, paths, secs);
+    true
+}
+
 /// Publishes an image.
 fn publish_image(
     shared: &Shared,
@@ -173,37 +176,20 @@ pub(super) fn rock(shared: &Shared, base: &Scene, request: Request, knobs: &Accu
         view.tilt_x = (view.tilt_x + ROCK_AMPLITUDE * swing).clamp(-MAX_TILT, MAX_TILT);
         let mut scene = base.clone();
         view.apply(&mut scene.stage);
-        let world = match build(shared, &scene) {
-            Ok(w) => Arc::new(w),
-            Err(Some(message)) => {
-                let s = shared.lock();
-                shared.publish(s, |s| {
-                    s.phase = Phase::Error;
-                    s.error = Some(message);
-                });
-                return;
-            }
-            Err(None) => return,
-        };
-        let scene = Arc::new(scene);
-        let Some((film, paths, secs)) = render_range(shared, &world, &scene, 0..2, 2) else {
+        let Some(world) = build(shared, &scene) else {
             return;
         };
-        publish_image(
-            shared,
-            (&scene, &world, view, knobs),
-            film,
-            2,
-            2,
-            paths,
-            secs,
-        );
+        let scene = Arc::new(scene);
+        if !quick_frame(shared, (&scene, &world, view, knobs), 2, 2) {
+            return;
+        }
         shared.lock().phase = Phase::Rocking;
     }
 }
 
-/// Builds the world of `scene`; `Err(None)` when stopped by a newer request.
-pub(super) fn build(shared: &Shared, scene: &Scene) -> Result<World, Option<String>> {
+/// Builds the world of `scene`; `None` when stopped by a newer request or failed (the failure
+/// is published as the session's error).
+pub(super) fn build(shared: &Shared, scene: &Scene) -> Option<Arc<World>> {
     let setup = Setup {
         deadline: None,
         cancel: Some(&shared.restart),
@@ -211,8 +197,11 @@ pub(super) fn build(shared: &Shared, scene: &Scene) -> Result<World, Option<Stri
         cache: Some(&shared.cache),
     };
     match crate::cli::load::build_world(&shared.recipe, scene, &setup) {
-        Ok(w) => Ok(w),
-        Err(e) if e.stopped() => Err(None),
-        Err(e) => Err(Some(format!("error: {e}"))),
+        Ok(w) => Some(Arc::new(w)),
+        Err(e) if e.stopped() => None,
+        Err(e) => {
+            shared.publish_error(format!("error: {e}"));
+            None
+        }
     }
 }

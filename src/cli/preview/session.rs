@@ -66,15 +66,11 @@ pub fn run_worker(shared: &Shared) {
             generation(shared, &mut loaded, request, reload)
         }));
         if run.is_err() {
-            let s = shared.lock();
-            shared.publish(s, |s| {
-                s.phase = Phase::Error;
-                s.error = Some(
-                    "internal error while rendering (a panic); edit the recipe or the \
-                                view to try again"
-                        .to_string(),
-                );
-            });
+            shared.publish_error(
+                "internal error while rendering (a panic); edit the recipe or the view to try \
+                 again"
+                    .to_string(),
+            );
         }
     }
 }
@@ -118,11 +114,7 @@ fn generation(shared: &Shared, loaded: &mut Option<Loaded>, request: Request, re
                 }
             }
             Err(message) => {
-                let s = shared.lock();
-                shared.publish(s, |s| {
-                    s.phase = Phase::Error;
-                    s.error = Some(message);
-                });
+                shared.publish_error(message);
                 return;
             }
         }
@@ -140,17 +132,8 @@ fn generation(shared: &Shared, loaded: &mut Option<Loaded>, request: Request, re
     request.view.apply(&mut scene.stage);
     shared.lock().phase = Phase::Building;
     let (reused0, built0) = shared.cache.counts();
-    let world = match build(shared, &scene) {
-        Ok(w) => Arc::new(w),
-        Err(Some(message)) => {
-            let s = shared.lock();
-            shared.publish(s, |s| {
-                s.phase = Phase::Error;
-                s.error = Some(message);
-            });
-            return;
-        }
-        Err(None) => return,
+    let Some(world) = build(shared, &scene) else {
+        return;
     };
     let (reused1, built1) = shared.cache.counts();
     {

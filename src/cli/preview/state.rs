@@ -258,6 +258,15 @@ impl Shared {
         self.wake.notify_all();
     }
 
+    /// Publishes an error (shown over the last good image) and the error phase.
+    pub fn publish_error(&self, message: String) {
+        let s = self.lock();
+        self.publish(s, |s| {
+            s.phase = Phase::Error;
+            s.error = Some(message);
+        });
+    }
+
     /// Asks the worker to stop.
     pub fn quit(&self) {
         self.lock().quit = true;
