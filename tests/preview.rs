@@ -187,6 +187,10 @@ fn refines_reloads_on_save_and_recovers_from_errors() {
     assert_eq!(p.get("/frame.png?exposure=99").status, 400);
     let done = p.wait("the budget", |s| s["state"] == "done");
     assert_eq!(done["spp"], 8);
+    assert_eq!(
+        done["draft"], false,
+        "the refined image has the session's knobs"
+    );
     let generation = done["generation"].as_u64().unwrap();
 
     // A one-number edit of one material: a new generation that rebuilds that material only.

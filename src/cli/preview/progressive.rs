@@ -117,6 +117,28 @@ fn wait_for_a_client(shared: &Shared) -> bool {
     true
 }
 
+/// A draft frame of `scene` with the Corrected model's albedo calibration off (docs/accuracy.md:
+/// a few per cent of albedo; most of a first build's time): one sample at a quarter of the size,
+/// shown until the calibrated world has its first pixels. Skipped when no material is calibrated.
+pub(super) fn draft(shared: &Shared, scene: &Scene, view: View, knobs: &Accuracy) {
+    let calibrated = |s: &crate::bsdf::StackDesc| {
+        s.calibration && s.model == crate::bsdf::Model::Corrected && !s.coats.is_empty()
+    };
+    if !scene.surface.stacks.iter().any(calibrated) {
+        return;
+    }
+    let mut knobs = knobs.clone();
+    knobs.calibration = Some(false);
+    let mut d = scene.clone();
+    if d.set_accuracy(&knobs, "preview draft").is_err() {
+        return;
+    }
+    let Some(world) = build(shared, &d) else {
+        return;
+    };
+    quick_frame(shared, (&Arc::new(d), &world, view, &knobs), 1, 4);
+}
+
 /// Renders samples `0..spp` at `1/scale` of the size and publishes them; `false` when stopped.
 fn quick_frame(
     shared: &Shared,

@@ -215,6 +215,9 @@ pub fn status_json(ctx: &Context, s: &super::state::State) -> Value {
         "generation": s.generation,
         "recipe": ctx.shared.recipe.display().to_string(),
         "state": s.phase.name(),
+        // An image rendered with other knobs than the session's: the quick draft without the
+        // calibration, or the last image before a knob change.
+        "draft": image.is_some_and(|i| i.knobs != s.knobs),
         "spp": image.map_or(0, |i| i.spp),
         "target_spp": r.spp,
         "paths_per_second": s.paths_per_second,

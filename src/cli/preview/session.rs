@@ -4,7 +4,7 @@
 //! starts a new generation; the last good image stays published until the new one has its first
 //! pixels, and a broken recipe publishes its errors beside it.
 
-use super::progressive::{build, refine, rock};
+use super::progressive::{build, draft, refine, rock};
 use super::state::{DEBOUNCE, Phase, Rebuild, Request, Shared};
 use super::watch::Inputs;
 use crate::scene::{Accuracy, Scene};
@@ -131,6 +131,11 @@ fn generation(shared: &Shared, loaded: &mut Option<Loaded>, request: Request, re
     }
     request.view.apply(&mut scene.stage);
     shared.lock().phase = Phase::Building;
+    // The session's first world waits for every material's tables: a draft without the
+    // Corrected calibration (most of that time) shows the stone first.
+    if shared.cache.counts() == (0, 0) {
+        draft(shared, &scene, request.view, &l.knobs);
+    }
     let (reused0, built0) = shared.cache.counts();
     let Some(world) = build(shared, &scene) else {
         return;
