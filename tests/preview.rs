@@ -349,7 +349,10 @@ fn a_recipe_that_vanishes_or_becomes_a_folder_is_an_error_not_a_panic() {
 fn a_closed_page_pauses_the_render_and_knobs_recompile() {
     let dir = scratch("idle");
     let p = start(&dir, &["--idle", "1", "--spp", "65536"]);
-    p.wait("the first image", |s| s["spp"].as_u64() >= Some(1));
+    // The calibrated image (the session's first is a draft, shown while the tables build).
+    p.wait("the first refined image", |s| {
+        s["spp"].as_u64() >= Some(1) && s["draft"] == false && s["state"] == "rendering"
+    });
     // Nobody asks for 2.5 s: the worker stops starting ranges.
     std::thread::sleep(Duration::from_millis(2500));
     let paused = p.status();
