@@ -219,16 +219,6 @@ fn wd(port: u16, method: &str, path: &str, body: Option<&Value>) -> Value {
     v
 }
 
-/// Resident memory of a process, KiB.
-fn rss_kib(pid: u32) -> u64 {
-    let s = std::fs::read_to_string(format!("/proc/{pid}/status")).unwrap();
-    s.lines()
-        .find_map(|l| l.strip_prefix("VmRSS:"))
-        .and_then(|v| v.split_whitespace().next())
-        .and_then(|v| v.parse().ok())
-        .unwrap()
-}
-
 fn url(p: &Preview) -> String {
     format!("http://127.0.0.1:{}/?t={}", p.port, p.token)
 }
@@ -366,7 +356,7 @@ fn the_page_renders_reloads_shows_errors_tilts_and_inspects() {
 
     // Fifty reloads: the server's memory stays bounded.
     let pid = p.child.id();
-    let rss0 = rss_kib(pid);
+    let rss0 = preview_common::proc_status(pid, "VmRSS");
     for _ in 0..50 {
         b.cmd("POST", "/refresh", Some(&json!({})));
         b.until(
@@ -374,7 +364,7 @@ fn the_page_renders_reloads_shows_errors_tilts_and_inspects() {
             "const i = document.getElementById('image'); return i && i.naturalWidth > 0;",
         );
     }
-    let rss1 = rss_kib(pid);
+    let rss1 = preview_common::proc_status(pid, "VmRSS");
     eprintln!("server memory: {rss0} KiB before 50 reloads, {rss1} KiB after");
     assert!(
         rss1 <= rss0 + 32 * 1024,
