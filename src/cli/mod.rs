@@ -18,6 +18,7 @@ macro_rules! outln {
     }};
 }
 
+pub mod args;
 pub mod brdf;
 pub mod check;
 pub mod compare;
