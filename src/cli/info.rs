@@ -39,7 +39,9 @@ pub fn run(args: &InfoArgs) -> Result<()> {
     Ok(())
 }
 
-fn stack_summary(s: &StackDesc) -> (String, String) {
+/// A stack's coats (top first) and base in one line each, as `info` and the preview's
+/// inspector print them.
+pub(crate) fn stack_summary(s: &StackDesc) -> (String, String) {
     let coats = if s.coats.is_empty() {
         "none".to_string()
     } else {

@@ -134,6 +134,7 @@ impl Compiler<'_> {
             );
         }
         let mut used = vec![false; self.materials.len()];
+        let mut map_labels = std::mem::take(&mut self.labels);
         let (mut nodes, entries, stops, fields) = (
             std::mem::take(&mut self.nodes),
             std::mem::take(&mut self.entries),
@@ -158,6 +159,7 @@ impl Compiler<'_> {
                 *u = true;
             }
         }
+        map_labels.resize(nodes.len(), String::new());
         let map = match Map::new(nodes, entries, stops, fields, root) {
             Ok(map) => Some(map),
             Err(e) => {
@@ -207,6 +209,7 @@ impl Compiler<'_> {
                 names,
                 stacks,
                 map,
+                map_labels,
                 used: used
                     .iter()
                     .enumerate()

@@ -42,6 +42,8 @@ pub(crate) struct Compiler<'a> {
     /// Keys of the errors already reported once (unknown names, cycles, too deep).
     pub(super) reported: HashSet<String>,
     pub(super) depth: usize,
+    /// The tree path (or `maps."name"`) where each node was defined, by node index.
+    pub(super) labels: Vec<String>,
     pub(super) effects: Effects,
     pub(super) errors: Vec<RecipeError>,
 }
@@ -61,6 +63,7 @@ impl<'a> Compiler<'a> {
             materials: (0..own).map(|i| (i, i as u32)).collect(),
             reported: HashSet::new(),
             depth: 0,
+            labels: vec![],
             effects: Effects::default(),
             errors: vec![],
         }
@@ -138,6 +141,14 @@ impl<'a> Compiler<'a> {
         self.depth += 1;
         let id = self.node_inner(desc, at);
         self.depth -= 1;
+        // A named map keeps the label of its definition (set by the inner call); a stand-in for
+        // an error is labelled where it stands.
+        self.labels.resize(self.nodes.len(), String::new());
+        if let Some(l) = self.labels.get_mut(id as usize)
+            && l.is_empty()
+        {
+            *l = at.to_string();
+        }
         id
     }
 

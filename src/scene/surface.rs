@@ -13,6 +13,10 @@ pub struct Surface {
     pub stacks: Vec<StackDesc>,
     /// The map tree; its leaves are indices into `names`/`stacks`.
     pub map: Map,
+    /// Where each map node is defined in the recipe, by node index: its tree path
+    /// (`surface.under.entries[1]`) or, for a named map, `maps."name"` (the pixel inspector's
+    /// names; not used by lookups).
+    pub map_labels: Vec<String>,
     /// Whether the tree uses each material.
     pub used: Vec<bool>,
     /// The translucent body, if the recipe gives one. Map leaves whose index is

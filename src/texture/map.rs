@@ -128,7 +128,7 @@ pub struct CellTrail {
 }
 
 impl CellTrail {
-    const EMPTY: CellTrail = CellTrail {
+    pub(super) const EMPTY: CellTrail = CellTrail {
         ids: [0; MAX_TRAIL],
         len: 0,
         sparse: 0,
@@ -154,7 +154,7 @@ impl CellTrail {
             .fold(0x243f_6a88_85a3_08d3, |h, &id| mix64(h ^ id))
     }
 
-    fn push(&mut self, id: u64, sparse: bool) {
+    pub(super) fn push(&mut self, id: u64, sparse: bool) {
         let k = usize::from(self.len);
         if k < MAX_TRAIL {
             self.ids[k] = id;

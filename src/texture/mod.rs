@@ -5,6 +5,7 @@
 //! - [`field`]: scalar fields (Perlin, turbulence, marble, sums, products, remaps) in a flat table.
 //! - [`bump`]: the crystal-facet bump map (tilt distributions, the rule for facets seen from behind).
 //! - [`simplify`]: the same tree with the glitter overlay, switch bands or facet bump left out.
+//! - [`explain`]: a lookup that records why it chose its material (the pixel inspector).
 //! - [`map`]: the runtime map tree — Voronoi surface and glitter maps, overlays, switches, material
 //!   leaves — and its allocation-free lookup.
 //!
@@ -12,6 +13,7 @@
 //! one random number, and every type is `Send + Sync`: lookups agree bit for bit on any thread.
 
 pub mod bump;
+pub mod explain;
 pub mod field;
 pub mod map;
 pub mod perlin;
@@ -19,6 +21,7 @@ pub mod simplify;
 pub mod voronoi;
 
 pub use bump::{FacetBump, Tilt};
+pub use explain::{MapDecision, MapExplanation, MapStep};
 pub use field::{FieldId, FieldNode, FieldTable};
 pub use map::{CellTrail, Entry, Map, MapError, MapHit, MapNode, NodeId, Stop, VoronoiNode};
 pub use perlin::{Octaves, perlin};

@@ -4,9 +4,8 @@
 use super::state::Image;
 use crate::image::{Curve, ToneMap};
 use crate::render::world::Hit;
-use crate::render::{CameraRays, Metadata, RenderStats, Rendered, exr_image};
+use crate::render::{Metadata, RenderStats, Rendered, exr_image};
 use crate::scene::Accuracy;
-use glam::{Vec2, Vec3};
 use serde_json::{Value, json};
 use std::path::{Path, PathBuf};
 
@@ -113,105 +112,16 @@ pub fn png(image: &Image, aov: Aov, tm: &ToneMap) -> Vec<u8> {
     out
 }
 
-/// The camera ray through the centre of film pixel `(x, y)` of `image`.
-fn primary_hit(image: &Image, x: u32, y: u32) -> (Option<Hit>, Vec3) {
-    let r = &image.scene.stage.render;
-    let (w, h) = (image.film.width, image.film.height);
-    let _ = r;
-    let rays = CameraRays::new(&image.scene.stage.camera, w, h, false);
-    let ray = rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5), Vec2::splat(0.5));
-    (image.world.intersect(&ray, f32::INFINITY), ray.dir)
-}
-
 /// The map's cell trail hash at the first hit of every film pixel (`None`: not the stone).
 fn cell_ids(image: &Image) -> Vec<Option<u64>> {
     let (w, h) = (image.film.width, image.film.height);
     (0..h)
         .flat_map(|y| (0..w).map(move |x| (x, y)))
-        .map(|(x, y)| match primary_hit(image, x, y).0 {
+        .map(|(x, y)| match super::inspect::primary_hit(image, x, y).0 {
             Some(Hit::Stone(s)) => Some(image.world.map.lookup(s.p_object, 0.5).trail.hash()),
             _ => None,
         })
         .collect()
-}
-
-/// The inspector's JSON for requested-image pixel `(x, y)`; `None` outside the image.
-pub fn inspect(image: &Image, x: u32, y: u32) -> Option<Value> {
-    let s = image.scale.max(1);
-    let (fx, fy) = (x / s, y / s);
-    if fx >= image.film.width || fy >= image.film.height {
-        return None;
-    }
-    let p = &image.film.pixels[(fy * image.film.width + fx) as usize];
-    let sigma = p.variance_of_mean().map(f32::sqrt);
-    let (hit, dir) = primary_hit(image, fx, fy);
-    let mut out = json!({
-        "x": x, "y": y,
-        "radiance": p.mean().0, "sigma": sigma, "spp": p.n,
-        "albedo": p.mean_albedo(),
-        "depth": (p.depth_n > 0).then(|| p.mean_depth()),
-        "hit": "sky", "point": null, "normal": null, "facet_normal": null,
-        "material": null, "cells": [], "glitter_cell": null,
-    });
-    match hit {
-        Some(Hit::Stone(h)) => {
-            let look = image.world.map.lookup(h.p_object, 0.5);
-            let m = look.material as usize;
-            let surface = &image.scene.surface;
-            let model = surface
-                .stacks
-                .get(m)
-                .map(|d| {
-                    let mut t = format!("{d:?}");
-                    if t.len() > 600 {
-                        let cut = (0..=600)
-                            .rev()
-                            .find(|&i| t.is_char_boundary(i))
-                            .unwrap_or(0);
-                        t.truncate(cut);
-                        t.push('…');
-                    }
-                    t
-                })
-                .unwrap_or_else(|| "the translucent body's boundary".into());
-            out["hit"] = json!("stone");
-            out["point"] = json!(h.p.to_array());
-            out["normal"] = json!(h.ns.to_array());
-            out["facet_normal"] = json!(look.facet.map(|f| f.to_array()));
-            out["material"] = json!({
-                "index": look.material,
-                "name": surface.names.get(m).cloned().unwrap_or_else(|| "body".into()),
-                "model": model,
-            });
-            out["cells"] = json!(
-                look.trail
-                    .ids()
-                    .iter()
-                    .map(|c| format!("{c:016x}"))
-                    .collect::<Vec<_>>()
-            );
-            out["glitter_cell"] = json!(look.trail.glitter_cell().map(|c| format!("{c:016x}")));
-        }
-        Some(Hit::Ground { p, .. }) => {
-            out["hit"] = json!("ground");
-            out["point"] = json!(p.to_array());
-            out["normal"] = json!(if dir.y <= 0.0 {
-                [0.0, 1.0, 0.0]
-            } else {
-                [0.0, -1.0, 0.0]
-            });
-        }
-        Some(Hit::Light { index, .. }) => {
-            out["hit"] = json!(format!("light {index}"));
-        }
-        Some(Hit::Platelet { p, material, .. }) => {
-            out["hit"] = json!("platelet");
-            out["point"] = json!(p.to_array());
-            out["material"] = json!({ "index": material, "name": "platelet", "model": "" });
-        }
-        None => {}
-    }
-    Some(out)
 }
 
 /// The batch command that renders `image` again (the same pixels once it has `spp` samples).

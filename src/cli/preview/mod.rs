@@ -12,6 +12,7 @@
 
 pub mod frame;
 pub mod http;
+pub mod inspect;
 pub mod progressive;
 pub mod server;
 pub mod session;

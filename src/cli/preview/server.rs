@@ -321,7 +321,7 @@ fn inspect(ctx: &Context, query: &[(String, String)]) -> Reply {
     let Some(image) = image else {
         return error(404, "no image yet");
     };
-    match frame::inspect(&image, x, y) {
+    match super::inspect::inspect(&image, x, y) {
         Some(v) => json_reply(200, &v),
         None => error(400, format!("pixel ({x}, {y}) is outside the image")),
     }
