@@ -401,5 +401,32 @@ fn the_page_renders_reloads_shows_errors_tilts_and_inspects() {
         let inspect = p.get(&format!("/inspect?x={x}&y=24")).json();
         assert_eq!(inspect["material"]["name"], want, "{inspect}");
         assert_ne!(inspect["material"]["name"], other);
+        // The page shows the map path: the switch and the stop it took.
+        let stop = if want == "left_red" { 0 } else { 1 };
+        let line = format!("surface.stops[{stop}]");
+        b.until(
+            "the map path",
+            &format!(
+                "const t = document.getElementById('inspector').innerText;\
+                 return t.includes('Switch: field') && t.includes('{line}') ? 1 : null;"
+            ),
+        );
     }
+
+    // A knob control re-renders and shows its cost beside it.
+    b.js("const s = document.querySelector('[data-knob=\"model\"]');\
+         s.value = 'course'; s.dispatchEvent(new Event('change')); return 1;");
+    let (cost, _) = b.until(
+        "the model knob's cost",
+        "const s = document.querySelector('[data-knob=\"model\"]');\
+         const t = s.parentElement.querySelector('.cost').textContent;\
+         return /paths\\/s \\(×/.test(t) ? t : null;",
+    );
+    eprintln!("model=course: {cost}");
+    assert!(
+        p.status()["knobs"]
+            .as_str()
+            .unwrap()
+            .contains("model=course")
+    );
 }

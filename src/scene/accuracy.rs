@@ -323,6 +323,13 @@ impl Knobs {
     /// Applies the render-level knobs to `scene`'s settings and the rest with
     /// [`Scene::set_accuracy`].
     pub fn apply(&self, scene: &mut Scene, by: &str) -> Result<(), KnobError> {
+        self.apply_render(scene);
+        scene.set_accuracy(&self.accuracy, by)
+    }
+
+    /// Applies only the render-level knobs (sampler, depths, medium scattering, platelets) to
+    /// `scene`'s settings.
+    pub fn apply_render(&self, scene: &mut Scene) {
         if let Some(s) = self.sampler {
             scene.stage.render.sampler = s;
         }
@@ -338,7 +345,6 @@ impl Knobs {
         if let Some(e) = self.platelets_explicit {
             scene.stage.render.platelets_explicit = e;
         }
-        scene.set_accuracy(&self.accuracy, by)
     }
 }
 

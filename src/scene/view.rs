@@ -4,14 +4,15 @@
 //! found interactively becomes a batch render or a farm job.
 //!
 //! Conventions: world `+y` is up (docs/design.md §4). Angles are in degrees. The pivot of every
-//! motion is the stone's object origin in world space (`Stage::to_world` applied to the origin).
+//! motion is the centre of the stone's bounding box in world space (its object origin for a mesh).
 //! Yaw turns about the vertical through the pivot (positive: counter-clockwise seen from above),
 //! pitch raises the camera above (positive) or below its recipe position, zoom scales the
 //! camera's distance to the pivot (below 1: closer). The stone's tilt turns it about the world
-//! `x` then `z` axes through the pivot; `light_yaw` turns every area light about the vertical
-//! through the pivot (the environment stays: it has no rotation).
+//! `x` then `z` axes through the pivot and lifts it so that its lowest point stays as high as it
+//! was (it rests on the floor as before; a mesh is not lifted); `light_yaw` turns every area light
+//! about the vertical through the pivot and an environment map with them.
 
-use super::stage::{Camera, LightShape, Stage};
+use super::stage::{Camera, Environment, LightShape, Stage};
 use glam::{Affine3A, Quat, Vec3};
 
 /// Largest |pitch| in degrees (the camera never passes over the pole, where its `up` flips).
@@ -179,7 +180,7 @@ impl View {
         if self.is_identity() {
             return;
         }
-        let pivot = stage.to_world.transform_point3(Vec3::ZERO);
+        let pivot = pivot(stage);
         stage.camera = self.camera(&stage.camera, pivot);
         if self.tilt_x != 0.0 || self.tilt_z != 0.0 {
             let r = Quat::from_rotation_z(self.tilt_z.to_radians())
@@ -187,7 +188,15 @@ impl View {
             let about = Affine3A::from_translation(pivot)
                 * Affine3A::from_quat(r)
                 * Affine3A::from_translation(-pivot);
-            stage.to_world = about * stage.to_world;
+            let before = lowest(stage, stage.to_world);
+            let tilted = about * stage.to_world;
+            // The tilted stone rests where it rested: lifted so that its lowest point is as high
+            // as before (a cabochon's rim does not dip through the floor).
+            let lift = match (before, lowest(stage, tilted)) {
+                (Some(b), Some(a)) if b > a => b - a,
+                _ => 0.0,
+            };
+            stage.to_world = Affine3A::from_translation(Vec3::Y * lift) * tilted;
         }
         if self.light_yaw != 0.0 {
             let r = Quat::from_rotation_y(self.light_yaw.to_radians());
@@ -198,6 +207,11 @@ impl View {
                     *u = r * *u;
                     *v = r * *v;
                 }
+            }
+            // An environment map turns with the lights (the same right-handed turn about +y);
+            // constant and gradient skies look the same turned.
+            if let Environment::Map { rotate, .. } = &mut stage.environment {
+                *rotate = (*rotate + self.light_yaw.to_radians()).rem_euclid(std::f32::consts::TAU);
             }
         }
     }
@@ -236,6 +250,21 @@ impl View {
         };
         Camera::look_at(from, to, Vec3::Y, base.projection).unwrap_or(*base)
     }
+}
+
+/// The pivot of every motion: the centre of the stone's bounding box in world space (the object
+/// origin for a mesh, whose bounds are known only once it is loaded).
+fn pivot(stage: &Stage) -> Vec3 {
+    let centre = stage.shape.centre().unwrap_or(Vec3::ZERO);
+    stage.to_world.transform_point3(centre)
+}
+
+/// The world height of the lowest point of the stone placed by `to_world`, from its shape's
+/// support function (`None` for a mesh): `min y = t_y − h(−Mᵀ e_y)` for `x ↦ M x + t`.
+fn lowest(stage: &Stage, to_world: Affine3A) -> Option<f32> {
+    let m = glam::Mat3::from(to_world.matrix3);
+    let down = -(m.transpose() * Vec3::Y);
+    Some(to_world.translation.y - stage.shape.support(down)?)
 }
 
 #[cfg(test)]
@@ -308,5 +337,67 @@ mod tests {
         .camera(&base, Vec3::ZERO);
         assert!(high.up.is_finite() && high.from.y > 0.0);
         assert!((high.from.y / high.from.length() - 85f32.to_radians().sin()).abs() < 1e-4);
+    }
+
+    /// A tilted studio cabochon keeps its lowest point on the floor (checked over points of its
+    /// rim, independently of the support function), turns about its centre, and an environment
+    /// map turns with the lights.
+    #[test]
+    fn a_tilted_stone_rests_on_the_floor_and_the_environment_turns_with_the_lights() {
+        let base = Stage::studio();
+        let rim_low = |st: &Stage| {
+            (0..3600)
+                .map(|k| {
+                    let a = k as f32 * std::f32::consts::TAU / 3600.0;
+                    let p = Vec3::new(a.cos(), 0.0, 0.8 * a.sin());
+                    st.to_world.transform_point3(p).y
+                })
+                .fold(f32::MAX, f32::min)
+        };
+        assert!(rim_low(&base).abs() < 1e-6);
+        for (tilt_x, tilt_z) in [
+            (20.0, 0.0),
+            (-20.0, 0.0),
+            (0.0, 35.0),
+            (-15.0, 25.0),
+            (60.0, -60.0),
+        ] {
+            let mut st = base.clone();
+            View {
+                tilt_x,
+                tilt_z,
+                ..View::default()
+            }
+            .apply(&mut st);
+            let low = rim_low(&st);
+            assert!(low.abs() < 2e-4, "{tilt_x} {tilt_z}: rim reaches y = {low}");
+            // The dome's top moved off the vertical: the stone did turn.
+            let top = st.to_world.transform_point3(Vec3::new(0.0, 0.55, 0.0));
+            assert!(top.x.abs() + top.z.abs() > 0.05, "{top}");
+        }
+        let mut st = base.clone();
+        st.environment = Environment::Map {
+            path: "sky.exr".into(),
+            intensity: 1.0,
+            rotate: 0.25,
+        };
+        let light = st.lights[0].center;
+        View {
+            light_yaw: 90.0,
+            ..View::default()
+        }
+        .apply(&mut st);
+        let Environment::Map { rotate, .. } = st.environment else {
+            unreachable!()
+        };
+        assert!((rotate - (0.25 + std::f32::consts::FRAC_PI_2)).abs() < 1e-6);
+        // The light turned the same way: a quarter turn counter-clockwise seen from above takes
+        // its offset (x, z) to (z, −x) about the pivot.
+        let p = pivot(&base);
+        let (a, b) = (light - p, st.lights[0].center - p);
+        assert!(
+            (b.x - a.z).abs() < 1e-5 && (b.z + a.x).abs() < 1e-5,
+            "{a} → {b}"
+        );
     }
 }

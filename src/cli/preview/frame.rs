@@ -5,7 +5,7 @@ use super::state::Image;
 use crate::image::{Curve, ToneMap};
 use crate::render::world::Hit;
 use crate::render::{Metadata, RenderStats, Rendered, exr_image};
-use crate::scene::Accuracy;
+use crate::scene::Knobs;
 use serde_json::{Value, json};
 use std::path::{Path, PathBuf};
 
@@ -125,7 +125,7 @@ fn cell_ids(image: &Image) -> Vec<Option<u64>> {
 }
 
 /// The batch command that renders `image` again (the same pixels once it has `spp` samples).
-pub fn command(recipe: &Path, image: &Image, knobs: &Accuracy, out: Option<&Path>) -> String {
+pub fn command(recipe: &Path, image: &Image, knobs: &Knobs, out: Option<&Path>) -> String {
     let r = &image.scene.stage.render;
     let mut cmd = format!(
         "lapidary render {} --size {}x{} --spp {}",
@@ -145,9 +145,22 @@ pub fn command(recipe: &Path, image: &Image, knobs: &Accuracy, out: Option<&Path
 }
 
 /// The command-line flags of `knobs` (each as `render` reads it).
-fn knob_flags(k: &Accuracy) -> String {
+fn knob_flags(knobs: &Knobs) -> String {
     let onoff = |b: bool| if b { "on" } else { "off" };
     let mut out = String::new();
+    if let Some(s) = knobs.sampler {
+        out += &format!(" --sampler {}", s.name());
+    }
+    if let Some(d) = knobs.max_depth {
+        out += &format!(" --max-depth {d}");
+    }
+    if let Some(d) = knobs.medium_depth {
+        out += &format!(" --medium-depth {d}");
+    }
+    if let Some(s) = knobs.medium_scattering {
+        out += &format!(" --medium-scattering {}", onoff(s));
+    }
+    let k = &knobs.accuracy;
     if let Some(m) = k.model {
         out += &format!(" --model {m}");
     }

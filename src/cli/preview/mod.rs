@@ -102,7 +102,10 @@ pub fn start(args: &PreviewArgs) -> Result<Running> {
     }
     std::fs::metadata(&args.recipe)
         .with_context(|| format!("{}: cannot read the recipe", args.recipe.display()))?;
-    let knobs = args.knobs.accuracy().map_err(anyhow::Error::msg)?;
+    let knobs = crate::scene::Knobs {
+        accuracy: args.knobs.accuracy().map_err(anyhow::Error::msg)?,
+        ..Default::default()
+    };
     let ip = args.bind.unwrap_or(IpAddr::V4(Ipv4Addr::LOCALHOST));
     if !ip.is_loopback() {
         eprintln!(

@@ -6,7 +6,7 @@ use super::state::{Image, Phase, ROCK_AMPLITUDE, ROCK_PERIOD, Request, Shared};
 use crate::render::world::Setup;
 use crate::render::{Control, Film, World, render};
 use crate::scene::view::{MAX_TILT, View};
-use crate::scene::{Accuracy, Scene};
+use crate::scene::{Knobs, Scene};
 use std::sync::Arc;
 use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
@@ -44,7 +44,7 @@ pub(super) fn refine(
     scene: Arc<Scene>,
     world: Arc<World>,
     view: View,
-    knobs: &Accuracy,
+    knobs: &Knobs,
 ) {
     let (w, h) = (scene.stage.render.width, scene.stage.render.height);
     let budget = scene.stage.render.spp;
@@ -120,7 +120,7 @@ fn wait_for_a_client(shared: &Shared) -> bool {
 /// A draft frame of `scene` with the Corrected model's albedo calibration off (docs/accuracy.md:
 /// a few per cent of albedo; most of a first build's time): one sample at a quarter of the size,
 /// shown until the calibrated world has its first pixels. Skipped when no material is calibrated.
-pub(super) fn draft(shared: &Shared, scene: &Scene, view: View, knobs: &Accuracy) {
+pub(super) fn draft(shared: &Shared, scene: &Scene, view: View, knobs: &Knobs) {
     let calibrated = |s: &crate::bsdf::StackDesc| {
         s.calibration && s.model == crate::bsdf::Model::Corrected && !s.coats.is_empty()
     };
@@ -128,9 +128,9 @@ pub(super) fn draft(shared: &Shared, scene: &Scene, view: View, knobs: &Accuracy
         return;
     }
     let mut knobs = knobs.clone();
-    knobs.calibration = Some(false);
+    knobs.accuracy.calibration = Some(false);
     let mut d = scene.clone();
-    if d.set_accuracy(&knobs, "preview draft").is_err() {
+    if d.set_accuracy(&knobs.accuracy, "preview draft").is_err() {
         return;
     }
     let Some(world) = build(shared, &d) else {
@@ -142,7 +142,7 @@ pub(super) fn draft(shared: &Shared, scene: &Scene, view: View, knobs: &Accuracy
 /// Renders samples `0..spp` at `1/scale` of the size and publishes them; `false` when stopped.
 fn quick_frame(
     shared: &Shared,
-    what: (&Arc<Scene>, &Arc<World>, View, &Accuracy),
+    what: (&Arc<Scene>, &Arc<World>, View, &Knobs),
     spp: u32,
     scale: u32,
 ) -> bool {
@@ -156,7 +156,7 @@ fn quick_frame(
 /// Publishes an image.
 fn publish_image(
     shared: &Shared,
-    (scene, world, view, knobs): (&Arc<Scene>, &Arc<World>, View, &Accuracy),
+    (scene, world, view, knobs): (&Arc<Scene>, &Arc<World>, View, &Knobs),
     film: Film,
     spp: u32,
     scale: u32,
@@ -178,6 +178,15 @@ fn publish_image(
             s.first_pixels = Some(s.generation_start.elapsed().as_secs_f64());
         }
         s.paths_per_second = paths as f64 / secs.max(1e-9);
+        // A full-resolution range with the session's knobs measures their speed (quick frames
+        // and the uncalibrated draft do not).
+        if scale == 1 && *knobs == s.knobs {
+            let pps = s.paths_per_second;
+            s.refined_paths_per_second = Some(pps);
+            for c in s.knob_costs.iter_mut().filter(|c| c.knobs == *knobs) {
+                c.after = Some(pps);
+            }
+        }
         s.render_seconds += secs;
         s.image = Some(image);
     });
@@ -185,7 +194,7 @@ fn publish_image(
 
 /// Shows the stone rocking: frames at half resolution, 2 spp, each at the tilt of its moment,
 /// until the request changes.
-pub(super) fn rock(shared: &Shared, base: &Scene, request: Request, knobs: &Accuracy) {
+pub(super) fn rock(shared: &Shared, base: &Scene, request: Request, knobs: &Knobs) {
     let start = Instant::now();
     shared.lock().phase = Phase::Rocking;
     while !shared.restart.load(Ordering::SeqCst) {

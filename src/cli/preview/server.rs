@@ -33,7 +33,7 @@ pub struct Context {
     /// Where exports go.
     pub out_dir: PathBuf,
     /// The command line's knobs (what `{"reset": true}` restores).
-    pub initial_knobs: crate::scene::Accuracy,
+    pub initial_knobs: crate::scene::Knobs,
 }
 
 /// A new random token (hex, 128 bits from the operating system's generator).
@@ -234,6 +234,11 @@ pub fn status_json(ctx: &Context, s: &super::state::State) -> Value {
         },
         "command": image.map(|i| frame::command(&ctx.shared.recipe, i, &i.knobs, None)),
         "knobs": s.knobs.to_string(),
+        "knob_costs": s.knob_costs.iter().map(|c| json!({
+            "key": c.key, "value": c.value, "before": c.before, "after": c.after,
+            "ratio": c.before.zip(c.after).map(|(b, a)| a / b.max(1e-9)),
+        })).collect::<Vec<_>>(),
+        "knob_choices": knob_choices(),
         "all_effects": crate::scene::Effect::ALL.iter().map(|e| e.name()).collect::<Vec<_>>(),
         "materials": image.map(|i| i.scene.surface.names.clone()),
         "effects": image.map(|i| i.scene.effects.iter().map(|e| e.name()).collect::<Vec<_>>()),
@@ -406,28 +411,74 @@ fn view(ctx: &Context, body: &[u8]) -> Reply {
 /// Sets accuracy knobs (JSON object of `knob: "value"` pairs, the keys and values of
 /// `lapidary tradeoff`'s knobs, e.g. `{"model": "course", "facet-bump": "off"}`; `{"reset":
 /// true}` goes back to the command line's): the recipe is compiled again with them.
+/// Most fields one `POST /knobs` may carry (every knob once, and `reset`).
+const MAX_KNOB_FIELDS: usize = 40;
+
+/// The page's knob controls: each knob `tradeoff` knows with its values (`platelets` only on or
+/// off: `render` has no flag for explicit or statistical); `null` for a number (its range is in
+/// the knob's error message).
+fn knob_choices() -> Value {
+    use crate::bsdf::{Distribution, Masking};
+    let onoff = json!(["on", "off"]);
+    let mut v = json!({
+        "model": ["course", "corrected", "reference"],
+        "fresnel": ["exact", "schlick", "lazanyi", "table"],
+        "distribution": Distribution::NAMES,
+        "masking": Masking::NAMES,
+        "compensation": onoff,
+        "calibration": onoff,
+        "sampler": ["sobol", "independent"],
+        "max-depth": null,
+        "medium-depth": null,
+        "medium-scattering": onoff,
+    });
+    for e in crate::scene::Effect::ALL {
+        v[e.name()] = onoff.clone();
+    }
+    v
+}
+
 fn knobs(ctx: &Context, body: &[u8]) -> Reply {
     let Ok(Value::Object(fields)) = serde_json::from_slice::<Value>(body) else {
         return error(400, "expected a JSON object of knobs");
     };
+    if fields.len() > MAX_KNOB_FIELDS {
+        return error(
+            400,
+            format!("at most {MAX_KNOB_FIELDS} knobs in one request"),
+        );
+    }
     let mut acc = ctx.shared.lock().knobs.clone();
+    let mut changed = vec![];
     for (k, v) in &fields {
         if k == "reset" {
             if v.as_bool() == Some(true) {
                 acc = ctx.initial_knobs.clone();
+                changed.push(("reset".to_string(), "command line".to_string()));
             }
             continue;
         }
+
         let value = match v {
             Value::String(t) => t.clone(),
             Value::Bool(b) => (if *b { "on" } else { "off" }).to_string(),
             _ => return error(400, format!("knob `{k}`: expected a string or true/false")),
         };
+        if k == "platelets" && !["on", "off"].contains(&value.to_ascii_lowercase().as_str()) {
+            // `render` has no flag for explicit/statistical platelets: an export's command
+            // could not repeat it. The effect's on/off is a knob like the others.
+            return error(
+                400,
+                "knob `platelets`: on or off in the preview (explicit or statistical is set by \
+                 `platelets:` in the recipe's `stage.render`)",
+            );
+        }
         if let Err(e) = acc.set(k, &value) {
             return error(400, e.to_string());
         }
+        changed.push((k.clone(), value));
     }
-    ctx.shared.set_knobs(acc);
+    ctx.shared.set_knobs(acc, &changed);
     let s = ctx.shared.lock();
     json_reply(200, &status_json(ctx, &s))
 }

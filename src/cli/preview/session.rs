@@ -7,7 +7,7 @@
 use super::progressive::{build, draft, refine, rock};
 use super::state::{DEBOUNCE, Phase, Rebuild, Request, Shared};
 use super::watch::Inputs;
-use crate::scene::{Accuracy, Scene};
+use crate::scene::{Knobs, Scene};
 use std::sync::Arc;
 use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
@@ -16,7 +16,7 @@ use std::time::{Duration, Instant};
 struct Loaded {
     scene: Scene,
     inputs: Inputs,
-    knobs: Accuracy,
+    knobs: Knobs,
 }
 
 /// The worker: runs until [`Shared::quit`]. Never panics out: a panic inside a generation is
@@ -157,12 +157,15 @@ fn generation(shared: &Shared, loaded: &mut Option<Loaded>, request: Request, re
 fn load(shared: &Shared) -> Result<Loaded, String> {
     let path = &shared.recipe;
     let knobs = shared.lock().knobs.clone();
-    match crate::cli::load::load_scene(path, &knobs, None) {
-        Ok(l) => Ok(Loaded {
-            inputs: Inputs::of_loaded(path, &l.recipe),
-            scene: l.scene,
-            knobs,
-        }),
+    match crate::cli::load::load_scene(path, &knobs.accuracy, None) {
+        Ok(mut l) => {
+            knobs.apply_render(&mut l.scene);
+            Ok(Loaded {
+                inputs: Inputs::of_loaded(path, &l.recipe),
+                scene: l.scene,
+                knobs,
+            })
+        }
         Err(e) => {
             let report = crate::cli::check::check_file(path);
             if report.errors.is_empty() {

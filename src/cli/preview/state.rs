@@ -5,7 +5,7 @@ use super::watch::Inputs;
 use crate::render::world::MaterialCache;
 use crate::render::{Film, World};
 use crate::scene::view::View;
-use crate::scene::{Accuracy, Scene};
+use crate::scene::{Knobs, Scene};
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard};
@@ -90,8 +90,27 @@ pub struct Image {
     /// The view it shows, rock tilt included.
     pub view: View,
     /// The knobs it was rendered with.
-    pub knobs: Accuracy,
+    pub knobs: Knobs,
 }
+
+/// What one knob change costs: the paths per second of full-resolution ranges before it and
+/// (updated with every range while the knobs stay) after it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct KnobCost {
+    /// The knob (`reset`: back to the command line's knobs).
+    pub key: String,
+    /// Its new value.
+    pub value: String,
+    /// Paths per second with the knobs before the change (`None`: none measured yet).
+    pub before: Option<f64>,
+    /// Paths per second with the knobs after it (`None`: not measured yet).
+    pub after: Option<f64>,
+    /// The knobs after the change.
+    pub knobs: Knobs,
+}
+
+/// Most knob changes the status lists (one per knob; the oldest is dropped).
+pub const MAX_KNOB_COSTS: usize = 32;
 
 /// How the last world was built.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -138,7 +157,11 @@ pub struct State {
     /// The files the recipe reads (watched).
     pub inputs: Inputs,
     /// Accuracy knobs: the command line's, then as the page sets them.
-    pub knobs: Accuracy,
+    pub knobs: Knobs,
+    /// Paths per second of the newest full-resolution range rendered with [`State::knobs`].
+    pub refined_paths_per_second: Option<f64>,
+    /// The page's knob changes and what each costs, newest last, one per knob.
+    pub knob_costs: Vec<KnobCost>,
     /// When a page last asked for anything: with no page for [`Shared::idle`] (the tab was
     /// closed) the worker pauses until one comes back.
     pub last_client: Instant,
@@ -171,7 +194,7 @@ impl Shared {
     pub fn new(
         recipe: PathBuf,
         request: Request,
-        knobs: Accuracy,
+        knobs: Knobs,
         threads: Option<usize>,
         idle: Duration,
     ) -> Arc<Shared> {
@@ -194,6 +217,8 @@ impl Shared {
                 rebuild: Rebuild::default(),
                 inputs: Inputs::of_recipe(&recipe),
                 knobs,
+                refined_paths_per_second: None,
+                knob_costs: vec![],
                 last_client: now,
             }),
             published: Condvar::new(),
@@ -224,10 +249,25 @@ impl Shared {
         }
     }
 
-    /// Replaces the knobs: the recipe is compiled again with them at once.
-    pub fn set_knobs(&self, knobs: Accuracy) {
+    /// Replaces the knobs (`changed`: the keys and values the page sent): the recipe is compiled
+    /// again with them at once, and each changed knob's cost is measured from the next ranges.
+    pub fn set_knobs(&self, knobs: Knobs, changed: &[(String, String)]) {
         let mut s = self.lock();
         if s.knobs != knobs {
+            let before = s.refined_paths_per_second.take();
+            for (key, value) in changed {
+                s.knob_costs.retain(|c| &c.key != key);
+                if s.knob_costs.len() >= MAX_KNOB_COSTS {
+                    s.knob_costs.remove(0);
+                }
+                s.knob_costs.push(KnobCost {
+                    key: key.clone(),
+                    value: value.clone(),
+                    before,
+                    after: None,
+                    knobs: knobs.clone(),
+                });
+            }
             s.knobs = knobs;
             s.reload = true;
             s.last_change = Instant::now() - DEBOUNCE;
