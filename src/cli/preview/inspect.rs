@@ -109,15 +109,16 @@ fn stack_json(d: &StackDesc) -> Value {
     })
 }
 
-/// One node of the map walk: its path, where the recipe defines it (a named map's name) and
-/// what it decided.
+/// One node of the map walk: its path, the name of the named map it is (`defined`), and what it
+/// decided.
 fn step_json(image: &Image, s: &MapStep) -> Value {
     let defined = image
         .scene
         .surface
         .map_labels
         .get(s.node as usize)
-        .filter(|l| !l.is_empty() && **l != s.path)
+        // Only a named map's own node: the nodes inside it are known by their path.
+        .filter(|l| l.starts_with("maps.\"") && l.ends_with('"') && **l != s.path)
         .cloned();
     // A switched-off overlay (`--effect glitter-overlay=off`) is a copy of its lower map.
     let replaced = matches!(
