@@ -35,6 +35,7 @@
 pub mod bsdf;
 pub mod cli;
 pub mod color;
+pub mod cut;
 pub mod geometry;
 pub mod image;
 pub mod light;

@@ -97,6 +97,17 @@ fn surface_points(shape: &Shape, n: u32, seed: u64) -> Vec<Vec3> {
                     size.y,
                     (rng.uniform() - 0.5) * size.z,
                 ),
+                Shape::Faceted(ref f) => {
+                    // Where the ray from the origin along `d` leaves the solid.
+                    let d64 = d.as_dvec3();
+                    let t = f
+                        .planes
+                        .iter()
+                        .filter(|p| p.normal.dot(d64) > 0.0)
+                        .map(|p| p.d / p.normal.dot(d64))
+                        .fold(f64::INFINITY, f64::min);
+                    (d64 * t).as_vec3()
+                }
                 Shape::Mesh { scale, .. } => d * scale,
             }
         })

@@ -95,8 +95,12 @@ pub(crate) fn recipe_inputs(recipe: &GemRecipe) -> Vec<(PathBuf, &'static str)> 
         .collect();
     let base = recipe.base_dir();
     if let Some(stage) = &recipe.content.stage {
-        if let Some(ShapeDesc::Mesh { file, .. }) = &stage.shape {
-            inputs.push((base.join(file), "the mesh"));
+        match &stage.shape {
+            Some(ShapeDesc::Mesh { file, .. }) => inputs.push((base.join(file), "the mesh")),
+            Some(ShapeDesc::Design { file, .. }) => {
+                inputs.push((base.join(file), "the GemCad design"))
+            }
+            _ => {}
         }
         if let Some(EnvironmentDesc::Map { file, .. }) = &stage.environment {
             inputs.push((base.join(file), "the environment map"));

@@ -248,6 +248,7 @@ impl Cabochon {
             ng: n,
             ns: n,
             p: self.point(piece),
+            facet: None,
         })
     }
 

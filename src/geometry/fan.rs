@@ -74,7 +74,7 @@ impl<'a> Fan<'a> {
                     Piece::Lower(u) => (c.lower_normal * u).normalize_or_zero(),
                 };
                 let p_object = c.shape.point(piece);
-                self.finish(t, p_object, ng, ng)
+                self.finish(t, p_object, ng, ng, None)
             }
             Kind::Solid(o) => {
                 let ray = Ray::new(o, self.stone.to_object().transform_vector3(dir));
@@ -87,7 +87,7 @@ impl<'a> Fan<'a> {
                 } else {
                     (nw * h.ns).normalize_or(ng)
                 };
-                self.finish(h.t, h.p, ng, ns)
+                self.finish(h.t, h.p, ng, ns, h.facet)
             }
         }
     }
@@ -95,7 +95,14 @@ impl<'a> Fan<'a> {
     /// The world hit from the object-space point and the world normals; `None` where they
     /// degenerate (a zero normal, a point overflowing the placement).
     #[inline(always)]
-    fn finish(&self, t: f32, p_object: Vec3, ng: Vec3, ns: Vec3) -> Option<StoneHit> {
+    fn finish(
+        &self,
+        t: f32,
+        p_object: Vec3,
+        ng: Vec3,
+        ns: Vec3,
+        facet: Option<u32>,
+    ) -> Option<StoneHit> {
         let p = self.stone.to_world().transform_point3(p_object);
         (ng != Vec3::ZERO && p.is_finite()).then_some(StoneHit {
             t,
@@ -103,6 +110,7 @@ impl<'a> Fan<'a> {
             p_object,
             ng,
             ns,
+            facet,
         })
     }
 

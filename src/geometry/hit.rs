@@ -21,6 +21,8 @@ pub struct ShapeHit {
     /// barycentric coordinates of the triangle), so it lies on the surface to within rounding,
     /// slightly more accurately than `ray.at(t)`.
     pub p: Vec3,
+    /// The facet of a faceted stone (its index in the design); `None` for the other shapes.
+    pub facet: Option<u32>,
 }
 
 /// Why a shape cannot be built.

@@ -295,7 +295,13 @@ impl Mesh {
             }
             _ => ng,
         };
-        ShapeHit { t, ng, ns, p }
+        ShapeHit {
+            t,
+            ng,
+            ns,
+            p,
+            facet: None,
+        }
     }
 
     /// Whether any triangle is hit with `0 < t < t_max` (the BVH's early-exit traversal).

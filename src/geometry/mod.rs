@@ -5,11 +5,13 @@
 //! ([`Solid`]); a [`Stone`] places one in the world.
 
 pub mod cabochon;
+pub mod clip;
 pub mod fan;
 pub mod frame;
 pub mod hit;
 pub mod mesh;
 pub mod placed;
+pub mod polytope;
 pub mod ray;
 pub mod shape;
 pub mod slab;
@@ -18,10 +20,12 @@ pub mod sphere;
 pub mod stone;
 
 pub use cabochon::Cabochon;
+pub use clip::{FacetPlane, Hull};
 pub use fan::Fan;
 pub use frame::Frame;
 pub use hit::{GeometryError, ShapeHit};
 pub use mesh::Mesh;
+pub use polytope::Polytope;
 pub use ray::{MediumId, Ray, offset_origin};
 pub use shape::Shape;
 pub use slab::Slab;

@@ -1,8 +1,10 @@
 //! The plain description of the stone's shape in object space (what a [`super::Solid`] is built
 //! from; the runtime stage re-exports it as `scene::stage::Shape`).
 
-use glam::Vec3;
+use super::clip::{FacetPlane, Hull, HullError};
+use glam::{DVec3, Vec3};
 use std::path::PathBuf;
+use std::sync::Arc;
 
 /// The stone's shape in object space.
 #[derive(Clone, Debug, PartialEq)]
@@ -27,6 +29,8 @@ pub enum Shape {
         /// Full sizes along x, y, z.
         size: Vec3,
     },
+    /// A faceted stone: the intersection of half-spaces (a parametric cut or a GemCad design).
+    Faceted(Arc<Facets>),
     /// A triangle mesh to be loaded from an OBJ file.
     Mesh {
         /// Resolved path of the file.
@@ -34,6 +38,61 @@ pub enum Shape {
         /// Uniform scale of its coordinates.
         scale: f32,
     },
+}
+
+/// A faceted stone's description: its half-spaces, the names of its facets (by facet index) and
+/// the corners of the solid they bound (for bounds and support queries before the solid is
+/// built).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Facets {
+    /// The half-spaces, object space.
+    pub planes: Vec<FacetPlane>,
+    /// Facet names by facet index (`"pavilion main 3"`).
+    pub names: Vec<String>,
+    /// What the design is (`"round brilliant"`, `"GemCad design cut.asc"`).
+    pub label: String,
+    /// The solid's corners.
+    pub vertices: Vec<DVec3>,
+    /// The planes (indices into `planes`) that bound a face of positive area.
+    pub bounding: Vec<usize>,
+    /// The solid's volume, object units³.
+    pub volume: f64,
+}
+
+impl Facets {
+    /// The solid of `planes`, checked to be bounded and non-empty.
+    pub fn new(
+        planes: Vec<FacetPlane>,
+        names: Vec<String>,
+        label: String,
+    ) -> Result<Facets, HullError> {
+        let extent = planes.iter().map(|p| p.d.abs()).fold(1.0f64, f64::max) * 1e3;
+        let hull = Hull::new(&planes, extent)?;
+        let mut bounding: Vec<usize> = hull.faces.iter().filter_map(|f| f.plane).collect();
+        bounding.sort_unstable();
+        bounding.dedup();
+        Ok(Facets {
+            vertices: hull.vertices(),
+            volume: hull.volume(),
+            bounding,
+            planes,
+            names,
+            label,
+        })
+    }
+
+    /// The facets (by index) whose planes bound no face: cut away by the others.
+    pub fn missing(&self) -> Vec<u32> {
+        let mut present: Vec<u32> = self
+            .bounding
+            .iter()
+            .map(|&i| self.planes[i].facet)
+            .collect();
+        present.sort_unstable();
+        (0..self.names.len() as u32)
+            .filter(|f| present.binary_search(f).is_err())
+            .collect()
+    }
 }
 
 impl Shape {
@@ -45,6 +104,14 @@ impl Shape {
                 Some(Vec3::new(0.0, 0.5 * (height - base), 0.0))
             }
             Shape::Slab { size } => Some(Vec3::new(0.0, 0.5 * size.y, 0.0)),
+            Shape::Faceted(ref f) => {
+                let lo = f.vertices.iter().fold(DVec3::INFINITY, |a, v| a.min(*v));
+                let hi = f
+                    .vertices
+                    .iter()
+                    .fold(DVec3::NEG_INFINITY, |a, v| a.max(*v));
+                Some(((lo + hi) * 0.5).as_vec3())
+            }
             Shape::Mesh { .. } => None,
         }
     }
@@ -52,6 +119,8 @@ impl Shape {
     /// The support function `h(d) = max { d · x : x in the solid }` (object space, any `d`): how
     /// far the solid reaches along `d`. Exact for every analytic shape (each is convex); `None`
     /// for a mesh (not loaded yet).
+    ///
+    /// A faceted stone reaches farthest at one of its corners.
     ///
     /// A cabochon is the upper half of the ellipsoid with semi-axes `(r₀, height, r₁)` joined at
     /// `y = 0` to the lower half of `(r₀, base, r₁)`: along a `d` with `d_y ≥ 0` the farthest point
@@ -70,6 +139,10 @@ impl Shape {
             }
             Shape::Slab { size } => {
                 Some(0.5 * (d.x.abs() * size.x + d.z.abs() * size.z) + (d.y * size.y).max(0.0))
+            }
+            Shape::Faceted(ref f) => {
+                let d = d.as_dvec3();
+                Some(f.vertices.iter().map(|v| v.dot(d)).fold(f64::MIN, f64::max) as f32)
             }
             Shape::Mesh { .. } => None,
         }

@@ -72,7 +72,13 @@ impl Slab {
         } else {
             self.lo[axis]
         };
-        Some(ShapeHit { t, ng, ns: ng, p })
+        Some(ShapeHit {
+            t,
+            ng,
+            ns: ng,
+            p,
+            facet: None,
+        })
     }
 
     /// Object-space bounds `(min, max)`.

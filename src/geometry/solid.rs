@@ -4,6 +4,7 @@
 use super::cabochon::Cabochon;
 pub use super::hit::{GeometryError, ShapeHit};
 use super::mesh::Mesh;
+use super::polytope::Polytope;
 use super::ray::Ray;
 use super::shape::Shape;
 use super::slab::Slab;
@@ -22,6 +23,8 @@ pub enum Solid {
     Cabochon(Cabochon),
     /// An axis-aligned box resting on y = 0.
     Slab(Slab),
+    /// A faceted stone: half-spaces intersected exactly.
+    Polytope(Polytope),
     /// A triangle mesh with its BVH.
     Mesh(Mesh),
 }
@@ -38,6 +41,7 @@ impl Solid {
                 base,
             } => Solid::Cabochon(Cabochon::new(radius.0, *height, radius.1, *base)?),
             Shape::Slab { size } => Solid::Slab(Slab::new(*size)?),
+            Shape::Faceted(f) => Solid::Polytope(Polytope::new(&f.planes, "faceted stone")?),
             Shape::Mesh { path, scale } => Solid::Mesh(Mesh::load(path, *scale)?),
         })
     }
@@ -49,6 +53,7 @@ impl Solid {
             Solid::Sphere(s) => s.intersect(ray, t_max),
             Solid::Cabochon(c) => c.intersect(ray, t_max),
             Solid::Slab(s) => s.intersect(ray, t_max),
+            Solid::Polytope(p) => p.intersect(ray, t_max),
             Solid::Mesh(m) => m.intersect(ray, t_max),
         }
     }
@@ -67,6 +72,7 @@ impl Solid {
             Solid::Sphere(s) => s.bounds(),
             Solid::Cabochon(c) => c.bounds(),
             Solid::Slab(s) => s.bounds(),
+            Solid::Polytope(p) => p.bounds(),
             Solid::Mesh(m) => m.bounds(),
         }
     }

@@ -76,6 +76,7 @@ impl Sphere {
             ng: n,
             ns: n,
             p: n * self.radius,
+            facet: None,
         })
     }
 

@@ -19,6 +19,8 @@ pub struct StoneHit {
     pub ng: Vec3,
     /// Unit world-space shading normal (in `ng`'s hemisphere).
     pub ns: Vec3,
+    /// The facet of a faceted stone (its index in the design); `None` for the other shapes.
+    pub facet: Option<u32>,
 }
 
 /// The stone's solid and its placement: object → world (`to_world`), its inverse, and the matrix

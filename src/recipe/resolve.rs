@@ -68,6 +68,8 @@ pub(crate) fn stage(
     let Some(desc) = &r.content.stage else {
         return Some(stage);
     };
+    // A faceted shape's errors (pushed once `file` no longer holds `errors`).
+    let mut shape_errors = vec![];
     if let Some(shape) = &desc.shape {
         stage.shape = match shape {
             ShapeDesc::Sphere { radius } => Shape::Sphere { radius: *radius },
@@ -81,6 +83,12 @@ pub(crate) fn stage(
                 base: *base,
             },
             ShapeDesc::Slab { size } => Shape::Slab { size: v3(*size) },
+            ShapeDesc::Cut(c) => {
+                super::faceted::cut(r, c, &mut shape_errors).unwrap_or(stage.shape.clone())
+            }
+            ShapeDesc::Design { file: name, width } => file(name, "asc", "design")
+                .and_then(|p| super::faceted::design(r, &p, name, *width, &mut shape_errors))
+                .unwrap_or(stage.shape.clone()),
             ShapeDesc::Mesh { file: name, scale } => Shape::Mesh {
                 path: file(name, "obj", "mesh").unwrap_or_default(),
                 scale: *scale,
@@ -122,6 +130,7 @@ pub(crate) fn stage(
             },
         };
     }
+    errors.append(&mut shape_errors);
     if let Some(lights) = &desc.lights {
         let lights_at = part_at("lights");
         stage.lights.clear();

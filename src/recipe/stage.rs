@@ -26,6 +26,10 @@ use indexmap::IndexMap;
 use serde::{Deserialize, Deserializer, Serialize};
 
 ranged!(length_range, "length", open 0.0, 1e4);
+
+fn two() -> f32 {
+    2.0
+}
 ranged!(fov_range, "fov", 1.0, 170.0);
 ranged!(aperture_range, "aperture", 0.0, 1e3);
 ranged!(intensity_range, "intensity", 0.0, 1e6);
@@ -267,6 +271,17 @@ pub enum ShapeDesc {
         /// Full sizes.
         #[serde(deserialize_with = "positive3")]
         size: V3,
+    },
+    /// A faceted stone of a parametric cut (`recipe::cut`).
+    Cut(super::cut::CutDesc),
+    /// A faceted stone from a GemCad `.asc` design (relative to the recipe), scaled to a girdle
+    /// width (the smaller of its extents along x and z).
+    Design {
+        /// The `.asc` file.
+        file: String,
+        /// Girdle width in object units, 0 <.. 1e4 (default 2).
+        #[serde(default = "two", deserialize_with = "length_range")]
+        width: f32,
     },
     /// A triangle mesh from a Wavefront OBJ file (relative to the recipe).
     Mesh {

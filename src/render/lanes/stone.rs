@@ -53,6 +53,7 @@ pub fn intersect(stone: &Stone, live: M, o: V3, d: V3) -> (M, [StoneHit; L]) {
         p_object: Vec3::ZERO,
         ng: Vec3::ZERO,
         ns: Vec3::ZERO,
+        facet: None,
     }; L];
     let Solid::Sphere(sphere) = stone.solid() else {
         let mut hit = M::splat(false);
@@ -109,6 +110,7 @@ pub fn intersect(stone: &Stone, live: M, o: V3, d: V3) -> (M, [StoneHit; L]) {
                 p_object: p_object.at(i),
                 ng: ngi,
                 ns: ns.at(i),
+                facet: None,
             };
         }
     }
