@@ -293,3 +293,150 @@ fn shapes_are_shared_not_copied() {
     let Shape::Faceted(g) = &copy else { panic!() };
     assert!(Arc::ptr_eq(f, g));
 }
+
+/// Every corner of the brilliant's parameter box on every outline, and 2 000 random points in it:
+/// each cut is either made with every facet present (girdle facets may vanish at a knife-edge
+/// girdle) and the stone closed, or refused with a message (never a panic).
+#[test]
+fn the_whole_parameter_range_cuts_or_is_refused() {
+    use lapidary::cut::Outline;
+    let outlines = [
+        Outline::Round,
+        Outline::Oval { ratio: 3.0 },
+        Outline::Marquise { ratio: 3.0 },
+        Outline::Pear { ratio: 1.0 },
+        Outline::Pear { ratio: 3.0 },
+        Outline::Cushion { ratio: 2.0 },
+    ];
+    // Ranges as `recipe::cut` allows them.
+    let ranges = [
+        (0.40, 0.80),
+        (20.0, 45.0),
+        (35.0, 50.0),
+        (0.0, 0.10),
+        (0.30, 0.70),
+        (0.50, 0.95),
+        (0.0, 0.10),
+    ];
+    let make = |x: [f64; 7], outline: Outline| Brilliant {
+        outline,
+        table: x[0],
+        crown: x[1],
+        pavilion: x[2],
+        girdle: x[3],
+        star: x[4],
+        lower_girdle: x[5],
+        culet: x[6],
+        girdle_facets: 64,
+    };
+    let (mut made, mut refused) = (0, 0);
+    let mut check = |b: Brilliant| match Cut::Brilliant(b).facets(2.0) {
+        Ok(f) => {
+            made += 1;
+            // Only girdle facets may vanish (where the girdle thins to a knife edge).
+            let lost = f
+                .missing()
+                .into_iter()
+                .filter(|&k| !f.names[k as usize].starts_with("girdle"));
+            assert!(f.volume > 0.0 && lost.count() == 0, "{b:?}");
+            Polytope::new(&f.planes, "sweep").unwrap();
+        }
+        Err(e) => {
+            refused += 1;
+            assert!(e.0.contains("facet"), "{b:?}: {e}");
+        }
+    };
+    for outline in outlines {
+        for corner in 0..128u32 {
+            let x: [f64; 7] = std::array::from_fn(|k| {
+                let (lo, hi) = ranges[k];
+                if corner & (1 << k) != 0 { hi } else { lo }
+            });
+            check(make(x, outline));
+        }
+    }
+    let mut rng = Rng::new(2024);
+    for k in 0..2000 {
+        let x: [f64; 7] = std::array::from_fn(|i| {
+            let (lo, hi) = ranges[i];
+            lo + (hi - lo) * f64::from(rng.uniform())
+        });
+        check(make(x, outlines[k % outlines.len()]));
+    }
+    println!("{made} cut, {refused} refused");
+    assert!(made > refused, "{made} cut, {refused} refused");
+}
+
+/// Bad cuts are refused where they are written: a number out of range at the number, a
+/// contradiction at the `Cut`, a broken `.asc` at its own line and column.
+#[test]
+fn bad_cuts_and_designs_are_refused_at_their_position() {
+    let dir = std::env::temp_dir().join(format!("lapidary-faceted-errors-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let head =
+        "(materials: {\"m\": (base: Lambert(albedo: Gray(0.5)))}, surface: Material(\"m\"),\n";
+    let error = |shape: &str| -> String {
+        let text = format!("{head} stage: (shape: {shape}))");
+        let path = dir.join("gem.ron");
+        match lapidary::recipe::GemRecipe::parse(path.to_str().unwrap(), &text)
+            .and_then(|r| r.compile())
+        {
+            Ok(_) => panic!("{shape} was accepted"),
+            Err(e) => e.to_string(),
+        }
+    };
+    // `line:col` of `needle` in the recipe's second line.
+    let at = |shape: &str, needle: &str| {
+        let line = format!(" stage: (shape: {shape}))");
+        format!("gem.ron:2:{}:", line.find(needle).unwrap() + 1)
+    };
+    let shape = "Cut(Brilliant(crown: 60.0))";
+    let e = error(shape);
+    let want = format!(
+        "{} crown = 60 is out of range: allowed 20 ..= 45",
+        at(shape, "60.0")
+    );
+    assert!(e.ends_with(&want), "{e}");
+    let shape = "Cut(Brilliant(outline: Pear(ratio: 0.5)))";
+    let e = error(shape);
+    let want = format!(
+        "{} ratio = 0.5 is out of range: allowed 1 ..= 3",
+        at(shape, "0.5")
+    );
+    assert!(e.ends_with(&want), "{e}");
+    let e = error("Cut(Brilliant(girdle_facets: 40))");
+    assert!(e.contains("a multiple of 16 in 16 ..= 256"), "{e}");
+    let shape = "Cut(Brilliant(table: 80.0, star: 30.0))";
+    let e = error(shape);
+    let want = format!(
+        "{} shape: Cut: star = 30.0 % with table = 80.0 %",
+        at(shape, "Cut")
+    );
+    assert!(e.contains(&want), "{e}");
+    assert!(e.contains("needs star > 48.6 %"), "{e}");
+    let e = error("Cut(Emerald(pavilion: [40.0, 50.0]))");
+    assert!(e.contains("flatter than the one before"), "{e}");
+    std::fs::write(
+        dir.join("broken.asc"),
+        "GemCad 5.0\r\ng 96 0\r\na 40 1.0 0 24\r\na 91 1 0\r\n",
+    )
+    .unwrap();
+    let e = error("Design(file: \"broken.asc\")");
+    assert!(
+        e.contains("broken.asc:4:3: angle = 91: allowed −90 ..= 90 degrees"),
+        "{e}"
+    );
+    let e = error("Design(file: \"missing.asc\")");
+    assert!(e.contains("design \"missing.asc\""), "{e}");
+    let e = error("Design(file: \"gem.ron\")");
+    assert!(e.contains("expected a .asc file"), "{e}");
+    // An open design: no table, so nothing closes it upward.
+    std::fs::write(
+        dir.join("open.asc"),
+        "GemCad 5.0\ng 96 0\na -40 1.0 0 24 48 72\n",
+    )
+    .unwrap();
+    let e = error("Design(file: \"open.asc\")");
+    assert!(e.contains("do not close the stone"), "{e}");
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -303,7 +303,16 @@ pub fn describe(recipe: &GemRecipe, scene: &Scene, points: u32) -> String {
     // Stage.
     let st = &scene.stage;
     let _ = writeln!(o, "\nstage:");
-    let _ = writeln!(o, "  shape        {:?}", st.shape);
+    match &st.shape {
+        Shape::Faceted(f) => {
+            let _ = writeln!(o, "  shape        {} (faceted)", f.label);
+            let p = crate::cut::metrics::proportions(f);
+            let _ = writeln!(o, "{}", p.describe("               "));
+        }
+        shape => {
+            let _ = writeln!(o, "  shape        {shape:?}");
+        }
+    }
     let _ = writeln!(
         o,
         "  ground       {}",

@@ -136,6 +136,19 @@ impl Brilliant {
             self.pavilion.to_radians().tan(),
         );
         let c = 22.5f64.to_radians().cos();
+        // The star points lie below the table only if `r_star cos 22.5° > table`: a large table
+        // needs long stars.
+        let t = self.table;
+        let min_star = t * (1.0 - c * c) / (c * (1.0 - t * c));
+        if self.star <= min_star {
+            return Err(CutError(format!(
+                "star = {:.1} % with table = {:.1} %: the star facets would rise above the table; \
+                 this table needs star > {:.1} %",
+                100.0 * self.star,
+                100.0 * t,
+                100.0 * min_star
+            )));
+        }
         let h = self.heights();
         let (yt, yb) = (h.girdle_top, -h.girdle_top);
         let (rs, rl) = self.point_radii();
@@ -144,15 +157,47 @@ impl Brilliant {
         let table: Vec<DVec3> = (0..8)
             .map(|k| m(polar(self.table, 45.0 * k as f64, h.table)))
             .collect();
-        let star: Vec<DVec3> = (0..8)
-            .map(|k| m(polar(rs, 45.0 * k as f64 + 22.5, yt + (1.0 - rs * c) * tc)))
-            .collect();
-        let lower: Vec<DVec3> = (0..8)
-            .map(|k| m(polar(rl, 45.0 * k as f64 + 22.5, yb - tp + rl * c * tp)))
-            .collect();
         let culet = DVec3::new(0.0, h.culet, 0.0);
         let top = |s: usize| m(polar(1.0, 22.5 * s as f64, yt));
         let bot = |s: usize| m(polar(1.0, 22.5 * s as f64, yb));
+        // The outline's horizontal tangent at the junction at `22.5° · s` (a central difference:
+        // at a marquise's or pear's point it bisects the corner).
+        let tangent = |s: usize| {
+            let e = 1e-4;
+            let a = 22.5 * s as f64;
+            m(polar(1.0, a + e, 0.0)) - m(polar(1.0, a - e, 0.0))
+        };
+        // Each bezel (pavilion main) is the plane through its table corner (the culet) and its
+        // girdle junction that contains the outline's tangent there: on the round the kite of
+        // the round design; on any outline a plane that meets the girdle at the junction only.
+        let main = |apex: DVec3, junction: DVec3, s: usize| {
+            let n = (junction - apex).cross(tangent(s)).normalize_or_zero();
+            (n, junction)
+        };
+        let bezels: Vec<(DVec3, DVec3)> =
+            (0..8).map(|k| main(table[k], top(2 * k), 2 * k)).collect();
+        let mains: Vec<(DVec3, DVec3)> = (0..8).map(|k| main(culet, bot(2 * k), 2 * k)).collect();
+        // Star (lower) points: on the ridge of two neighbouring bezels (mains), at the round
+        // design's height.
+        let ridge = |a: (DVec3, DVec3), b: (DVec3, DVec3), y: f64| -> Result<DVec3, CutError> {
+            let (na, nb) = (a.0, b.0);
+            let (da, db) = (na.dot(a.1) - na.y * y, nb.dot(b.1) - nb.y * y);
+            let det = na.x * nb.z - na.z * nb.x;
+            if det.abs() < 1e-12 {
+                return Err(CutError("two neighbouring main facets are parallel".into()));
+            }
+            Ok(DVec3::new(
+                (da * nb.z - db * na.z) / det,
+                y,
+                (na.x * db - nb.x * da) / det,
+            ))
+        };
+        let star: Vec<DVec3> = (0..8)
+            .map(|k| ridge(bezels[k], bezels[(k + 1) % 8], yt + (1.0 - rs * c) * tc))
+            .collect::<Result<_, _>>()?;
+        let lower: Vec<DVec3> = (0..8)
+            .map(|k| ridge(mains[k], mains[(k + 1) % 8], yb - tp + rl * c * tp))
+            .collect::<Result<_, _>>()?;
         let mut f = Builder::new(DVec3::new(0.0, 0.5 * (h.table + h.culet), 0.0));
         f.with_normal(DVec3::Y, table[0], "table".into())?;
         for k in 0..8 {
@@ -163,13 +208,8 @@ impl Brilliant {
                 format!("star {}", k + 1),
             )?;
         }
-        for k in 0..8 {
-            f.through(
-                table[k],
-                star[(k + 7) % 8],
-                top(2 * k),
-                format!("bezel {}", k + 1),
-            )?;
+        for (k, &(n, at)) in bezels.iter().enumerate() {
+            f.facing_out(n, at, format!("bezel {}", k + 1))?;
         }
         for s in 0..16 {
             f.through(
@@ -179,8 +219,8 @@ impl Brilliant {
                 format!("upper girdle {}", s + 1),
             )?;
         }
-        for (k, &l) in lower.iter().enumerate() {
-            f.through(culet, l, bot(2 * k), format!("pavilion main {}", k + 1))?;
+        for (k, &(n, at)) in mains.iter().enumerate() {
+            f.facing_out(n, at, format!("pavilion main {}", k + 1))?;
         }
         for s in 0..16 {
             f.through(

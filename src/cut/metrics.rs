@@ -117,6 +117,42 @@ pub fn proportions(f: &Facets) -> Proportions {
     }
 }
 
+impl Proportions {
+    /// The proportions as `lapidary info` prints them, one item per line, indented by `indent`.
+    pub fn describe(&self, indent: &str) -> String {
+        let mut s = format!(
+            "{indent}length × width {:.4} × {:.4} (ratio {:.3}), total depth {:.2} %",
+            self.length,
+            self.width,
+            self.length / self.width,
+            self.depth_pct
+        );
+        if let Some(t) = self.table_pct {
+            s += &format!("\n{indent}table {t:.2} % (across z)");
+        }
+        if let (Some(c), Some(p), Some((thin, thick))) =
+            (self.crown_pct, self.pavilion_pct, self.girdle_pct)
+        {
+            s += &format!(
+                "\n{indent}crown height {c:.2} %, pavilion depth {p:.2} %, girdle {thin:.2} % to \
+                 {thick:.2} %"
+            );
+        }
+        let groups: Vec<String> = self
+            .groups
+            .iter()
+            .map(|(g, n)| format!("{g} {n}"))
+            .collect();
+        s += &format!(
+            "\n{indent}{} facets ({}); volume {:.4} units³",
+            self.facets,
+            groups.join(", "),
+            self.volume
+        );
+        s
+    }
+}
+
 fn ys_span(v: impl Iterator<Item = f64> + Clone) -> f64 {
     v.clone().fold(f64::NEG_INFINITY, f64::max) - v.fold(f64::INFINITY, f64::min)
 }

@@ -62,7 +62,13 @@ impl Cut {
             .map(|p| FacetPlane { d: p.d * s, ..p })
             .collect();
         let f = Facets::new(planes, names, label).map_err(|e| CutError(e.to_string()))?;
-        let missing = f.missing();
+        // Girdle facets may vanish where the girdle thins to a knife edge; any other facet cut
+        // away means the proportions contradict each other.
+        let missing: Vec<u32> = f
+            .missing()
+            .into_iter()
+            .filter(|&k| !f.names[k as usize].starts_with("girdle"))
+            .collect();
         if let Some(&first) = missing.first() {
             return Err(CutError(format!(
                 "the proportions cut away {} facet{} ({}{}): change the angles or lengths",
@@ -129,6 +135,12 @@ impl Builder {
         self.planes.push(p);
         self.names.push(name);
         Ok(())
+    }
+
+    /// The facet through `p` with normal `±n`, the sign that faces away from the inside point.
+    pub fn facing_out(&mut self, n: DVec3, p: DVec3, name: String) -> Result<(), CutError> {
+        let n = if n.dot(self.inside - p) > 0.0 { -n } else { n };
+        self.with_normal(n, p, name)
     }
 
     /// The facet with outward normal `n` through `p`.
