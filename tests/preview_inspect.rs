@@ -156,3 +156,29 @@ fn the_inspector_follows_the_camera_ray_into_a_translucent_body() {
         pixels.len()
     );
 }
+
+#[test]
+fn the_inspector_names_the_facet_of_a_cut_stone() {
+    let dir = scratch("inspect-facet");
+    std::fs::write(
+        dir.join("lepidolite.ron"),
+        r#"(materials: {"m": (base: Lambert(albedo: Gray(0.5)))}, surface: Material("m"),
+            stage: (shape: Cut(Brilliant()), ground: Off,
+                    camera: Orthographic(from: (0.0, 5.0, 0.001), to: (0.0, 0.0, 0.0), height: 2.4)))"#,
+    )
+    .unwrap();
+    let p = start(&dir, &["--spp", "1"]);
+    p.wait("the first image", |s| s["state"] == "done");
+    // Seen from above: the table in the middle, a crown facet off it, nothing at the corner.
+    let centre = p.get("/inspect?x=32&y=24").json();
+    assert_eq!(centre["facet"], "table", "{centre}");
+    let side = p.get("/inspect?x=50&y=24").json();
+    let name = side["facet"].as_str().unwrap();
+    assert!(
+        ["star", "bezel", "upper girdle"]
+            .iter()
+            .any(|g| name.starts_with(g)),
+        "{side}"
+    );
+    assert!(p.get("/inspect?x=0&y=0").json()["facet"].is_null());
+}

@@ -32,9 +32,14 @@ pub struct Proportions {
     pub volume: f64,
 }
 
-/// The group of a facet name: `"pavilion main 3"` → `"pavilion main"`, `"P1 @ 12"` → `"P1"`.
+/// The group of a facet name: `"pavilion main 3"` → `"pavilion main"`, `"P1 @ 12"` → `"P1"`,
+/// `"crown 2 (+x)"` → `"crown 2"`.
 pub fn group(name: &str) -> &str {
     if let Some((g, _)) = name.split_once(" @ ") {
+        return g;
+    }
+    // A step cut's side: `"crown 2 (+x)"` → `"crown 2"`.
+    if let Some((g, _)) = name.split_once(" (") {
         return g;
     }
     match name.rsplit_once(' ') {

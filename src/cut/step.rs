@@ -118,11 +118,15 @@ impl Step {
             let inset = i as f64 * crown_width;
             for &(m, e, side) in sides.iter().filter(|s| self.corner_at(s.2, inset)) {
                 let at = m * (e - inset) + DVec3::Y * crown_heights[i];
-                f.with_normal(m * s + DVec3::Y * c, at, format!("crown {} {side}", i + 1))?;
+                f.with_normal(
+                    m * s + DVec3::Y * c,
+                    at,
+                    format!("crown {} ({side})", i + 1),
+                )?;
             }
         }
         for &(m, e, side) in &sides {
-            f.with_normal(m, m * e, format!("girdle {side}"))?;
+            f.with_normal(m, m * e, format!("girdle ({side})"))?;
         }
         for (i, &angle) in self.pavilion.iter().enumerate() {
             let (s, c) = angle.to_radians().sin_cos();
@@ -132,7 +136,7 @@ impl Step {
                 f.with_normal(
                     m * s - DVec3::Y * c,
                     at,
-                    format!("pavilion {} {side}", i + 1),
+                    format!("pavilion {} ({side})", i + 1),
                 )?;
             }
         }

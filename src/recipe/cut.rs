@@ -247,14 +247,14 @@ impl CutDesc {
                         s.ratio.unwrap_or(1.4),
                         s.corner.unwrap_or(15.0),
                         vec![50.0, 40.0, 30.0],
-                        vec![60.0, 50.0, 42.0],
+                        vec![55.0, 45.0, 38.0],
                     ),
                     CutDesc::Square(_) => (
                         StepKind::Square,
                         1.0,
                         s.corner.unwrap_or(25.0),
                         vec![50.0, 40.0, 30.0],
-                        vec![60.0, 50.0, 42.0],
+                        vec![55.0, 45.0, 38.0],
                     ),
                     _ => (
                         StepKind::Princess,

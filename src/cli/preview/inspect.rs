@@ -44,6 +44,7 @@ pub fn inspect(image: &Image, x: u32, y: u32) -> Option<Value> {
         "depth": (p.depth_n > 0).then(|| p.mean_depth()),
         "hit": "sky", "point": null, "normal": null, "facet_normal": null,
         "material": null, "map": [], "cells": [], "glitter_cell": null, "inside": null,
+        "facet": null,
     });
     let surface = &image.scene.surface;
     match hit {
@@ -54,6 +55,12 @@ pub fn inspect(image: &Image, x: u32, y: u32) -> Option<Value> {
             out["point"] = json!(h.p.to_array());
             out["normal"] = json!(h.ns.to_array());
             out["facet_normal"] = json!(look.hit.facet.map(|f| f.to_array()));
+            // A faceted stone's facet, by name.
+            if let (Some(k), crate::geometry::Shape::Faceted(f)) =
+                (h.facet, &image.scene.stage.shape)
+            {
+                out["facet"] = json!(f.names.get(k as usize));
+            }
             out["material"] = json!({
                 "index": m,
                 "name": surface.name(m),

@@ -10,6 +10,7 @@
 //! routes and the checks that make it safe to leave running), [`frame`] (PNGs, the inspector,
 //! the export), `page.html` (the page, compiled in).
 
+pub mod choices;
 pub mod frame;
 pub mod http;
 pub mod inspect;

@@ -238,7 +238,7 @@ pub fn status_json(ctx: &Context, s: &super::state::State) -> Value {
             "key": c.key, "value": c.value, "before": c.before, "after": c.after,
             "ratio": c.before.zip(c.after).map(|(b, a)| a / b.max(1e-9)),
         })).collect::<Vec<_>>(),
-        "knob_choices": knob_choices(),
+        "knob_choices": super::choices::knob_choices(),
         "all_effects": crate::scene::Effect::ALL.iter().map(|e| e.name()).collect::<Vec<_>>(),
         "materials": image.map(|i| i.scene.surface.names.clone()),
         "effects": image.map(|i| i.scene.effects.iter().map(|e| e.name()).collect::<Vec<_>>()),
@@ -411,41 +411,17 @@ fn view(ctx: &Context, body: &[u8]) -> Reply {
 /// Sets accuracy knobs (JSON object of `knob: "value"` pairs, the keys and values of
 /// `lapidary tradeoff`'s knobs, e.g. `{"model": "course", "facet-bump": "off"}`; `{"reset":
 /// true}` goes back to the command line's): the recipe is compiled again with them.
-/// Most fields one `POST /knobs` may carry (every knob once, and `reset`).
-const MAX_KNOB_FIELDS: usize = 40;
-
-/// The page's knob controls: each knob `tradeoff` knows with its values (`platelets` only on or
-/// off: `render` has no flag for explicit or statistical); `null` for a number (its range is in
-/// the knob's error message).
-fn knob_choices() -> Value {
-    use crate::bsdf::{Distribution, Masking};
-    let onoff = json!(["on", "off"]);
-    let mut v = json!({
-        "model": ["course", "corrected", "reference"],
-        "fresnel": ["exact", "schlick", "lazanyi", "table"],
-        "distribution": Distribution::NAMES,
-        "masking": Masking::NAMES,
-        "compensation": onoff,
-        "calibration": onoff,
-        "sampler": ["sobol", "independent"],
-        "max-depth": null,
-        "medium-depth": null,
-        "medium-scattering": onoff,
-    });
-    for e in crate::scene::Effect::ALL {
-        v[e.name()] = onoff.clone();
-    }
-    v
-}
-
 fn knobs(ctx: &Context, body: &[u8]) -> Reply {
     let Ok(Value::Object(fields)) = serde_json::from_slice::<Value>(body) else {
         return error(400, "expected a JSON object of knobs");
     };
-    if fields.len() > MAX_KNOB_FIELDS {
+    if fields.len() > super::choices::MAX_KNOB_FIELDS {
         return error(
             400,
-            format!("at most {MAX_KNOB_FIELDS} knobs in one request"),
+            format!(
+                "at most {} knobs in one request",
+                super::choices::MAX_KNOB_FIELDS
+            ),
         );
     }
     let mut acc = ctx.shared.lock().knobs.clone();
