@@ -6,8 +6,6 @@
 mod preview_common;
 
 use preview_common::{scratch, start};
-use std::path::Path;
-use std::process::Command;
 
 #[test]
 fn every_offered_knob_value_is_accepted_and_bad_ones_are_refused() {
@@ -98,35 +96,7 @@ fn a_knob_change_shows_its_cost_and_exports_as_its_command() {
     let r = p.post("/export", "");
     assert_eq!(r.status, 200, "{}", String::from_utf8_lossy(&r.body));
     let v = r.json();
-    let exported = lapidary::image::read_exr(Path::new(v["exr"].as_str().unwrap())).unwrap();
-    let mut args: Vec<String> = v["command"]
-        .as_str()
-        .unwrap()
-        .split(' ')
-        .skip(1)
-        .map(|a| a.trim_matches('\'').to_string())
-        .collect();
-    let at = args.iter().position(|a| a == "--output").unwrap();
-    let again = dir.join("again.exr");
-    args[at + 1] = again.display().to_string();
-    let st = Command::new(env!("CARGO_BIN_EXE_lapidary"))
-        .args(&args)
-        .arg("--quiet")
-        .status()
-        .unwrap();
-    assert!(st.success());
-    let batch = lapidary::image::read_exr(&again).unwrap();
-    for c in &exported.channels {
-        let b = batch.channels.iter().find(|b| b.name == c.name).unwrap();
-        assert!(
-            c.data
-                .iter()
-                .zip(&b.data)
-                .all(|(x, y)| x.to_bits() == y.to_bits()),
-            "channel {} differs",
-            c.name
-        );
-    }
+    preview_common::export_is_its_command(&v, &dir);
 
     // A second change of one knob replaces its entry; the reset is listed too.
     let r = p.post("/knobs", r#"{"max-depth": "5"}"#);

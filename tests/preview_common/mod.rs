@@ -224,3 +224,37 @@ pub fn proc_status(pid: u32, field: &str) -> u64 {
         .and_then(|v| v.parse().ok())
         .unwrap_or_else(|| panic!("no {field} in /proc/{pid}/status"))
 }
+
+/// Runs the batch command an export printed (`v` is the export's JSON) to another file in `dir`
+/// and checks that it renders the exported EXR again, channel by channel and bit for bit;
+/// returns the batch render.
+pub fn export_is_its_command(v: &Value, dir: &Path) -> lapidary::image::ExrImage {
+    let exported = lapidary::image::read_exr(Path::new(v["exr"].as_str().unwrap())).unwrap();
+    let mut args: Vec<String> = v["command"]
+        .as_str()
+        .unwrap()
+        .split(' ')
+        .skip(1)
+        .map(|a| a.trim_matches('\'').to_string())
+        .collect();
+    let at = args.iter().position(|a| a == "--output").unwrap();
+    let again = dir.join("again.exr");
+    args[at + 1] = again.display().to_string();
+    let st = Command::new(env!("CARGO_BIN_EXE_lapidary"))
+        .args(&args)
+        .arg("--quiet")
+        .status()
+        .unwrap();
+    assert!(st.success());
+    let batch = lapidary::image::read_exr(&again).unwrap();
+    for c in &exported.channels {
+        let b = batch.channels.iter().find(|b| b.name == c.name).unwrap();
+        let same = c
+            .data
+            .iter()
+            .zip(&b.data)
+            .all(|(x, y)| x.to_bits() == y.to_bits());
+        assert!(same, "channel {} differs", c.name);
+    }
+    batch
+}
