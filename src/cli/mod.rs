@@ -22,6 +22,7 @@ pub mod args;
 pub mod brdf;
 pub mod check;
 pub mod compare;
+pub mod cut;
 pub mod farm;
 pub mod info;
 pub mod knobs;
@@ -73,6 +74,10 @@ pub enum Command {
     /// saved, shows errors over the last good image, and orbits, tilts, rocks and inspects the
     /// stone. Runs until Ctrl-C.
     Preview(preview::PreviewArgs),
+    /// The cut report: the stone face-up under ISO, COS and ASET lighting at each tilt — a
+    /// contact sheet, a CSV and a table of light return, ASET shares and leakage with their
+    /// standard errors.
+    Cut(cut::CutArgs),
     /// Merge part renders (`render --samples A..B`) into the render of the whole range: checks
     /// they belong together and cover every sample once; the result equals a one-machine
     /// render bit for bit.
@@ -103,6 +108,7 @@ pub fn run() -> ExitCode {
         Command::Tradeoff(args) => tradeoff::run(&args),
         Command::Merge(args) => merge::run(&args),
         Command::Preview(args) => preview::run(&args),
+        Command::Cut(args) => cut::run(&args),
         Command::Farm(args) => farm::run(&args),
         Command::Render(args) => match render::run(&args) {
             Ok(false) => Ok(()),
