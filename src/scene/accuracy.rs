@@ -327,8 +327,7 @@ impl Knobs {
         scene.set_accuracy(&self.accuracy, by)
     }
 
-    /// Applies only the render-level knobs (sampler, depths, medium scattering, platelets) to
-    /// `scene`'s settings.
+    /// Applies only the render-level knobs (sampler, depths, scattering, platelets) to `scene`.
     pub fn apply_render(&self, scene: &mut Scene) {
         if let Some(s) = self.sampler {
             scene.stage.render.sampler = s;

@@ -175,54 +175,21 @@ impl Walk<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::texture::map::tests::voronoi;
-    use crate::texture::map::{Entry, Stop};
-    use crate::texture::{FieldNode, FieldTable, Octaves};
+    use crate::texture::{FieldNode, Octaves};
 
     /// Materials 0–3: a sparse glitter Voronoi (material 2) over a dense one (0 or 1), under a
     /// switch on a Perlin field with a blend band whose upper stop is material 3.
     fn fixture() -> Map {
-        let nodes = vec![
-            MapNode::Material(0),
-            MapNode::Material(1),
-            MapNode::Material(2),
-            voronoi(0, 2, 1.0, 1),
-            voronoi(2, 1, 0.25, 2),
-            MapNode::Overlay { under: 3, over: 4 },
-            MapNode::Material(3),
-            MapNode::Switch {
-                field: 0,
-                first: 0,
-                count: 2,
-                blend: 0.2,
+        let field = FieldNode::Fbm {
+            inv_scale: 3.0,
+            octaves: Octaves {
+                octaves: 3,
+                gain: 0.5,
+                lacunarity: 2.0,
+                seed: 7,
             },
-        ];
-        let entry = |cumulative, node| Entry { cumulative, node };
-        let entries = vec![entry(0.5, 0), entry(1.0, 1), entry(1.0, 2)];
-        let mut fields = FieldTable::default();
-        let f = fields
-            .add(FieldNode::Fbm {
-                inv_scale: 3.0,
-                octaves: Octaves {
-                    octaves: 3,
-                    gain: 0.5,
-                    lacunarity: 2.0,
-                    seed: 7,
-                },
-            })
-            .unwrap();
-        let stops = vec![
-            Stop {
-                threshold: f32::NEG_INFINITY,
-                node: 5,
-            },
-            Stop {
-                threshold: 0.0,
-                node: 6,
-            },
-        ];
-        assert_eq!(f, 0);
-        Map::new(nodes, entries, stops, fields, 7).unwrap()
+        };
+        crate::texture::fixtures::glitter_under_switch(field, 0.0, 0.2)
     }
 
     #[test]

@@ -15,6 +15,8 @@
 pub mod bump;
 pub mod explain;
 pub mod field;
+#[cfg(test)]
+pub(crate) mod fixtures;
 pub mod map;
 pub mod perlin;
 pub mod simplify;

@@ -40,9 +40,7 @@ impl Map {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::texture::map::tests::voronoi;
-    use crate::texture::map::{Entry, Stop};
-    use crate::texture::{FieldNode, FieldTable};
+    use crate::texture::FieldNode;
     use glam::Vec3;
 
     const ALL: MapEffects = MapEffects {
@@ -52,39 +50,10 @@ mod tests {
     };
 
     /// Materials 0–3: a sparse glitter Voronoi (material 2) over a dense one (0 or 1), both under
-    /// a switch on `x` with a blend band of 0.4 around 0.5 whose upper stop is material 3.
+    /// a constant switch (0, below its threshold 0.1, inside its band of 0.4) whose upper stop is
+    /// material 3.
     fn fixture() -> Map {
-        let nodes = vec![
-            MapNode::Material(0),
-            MapNode::Material(1),
-            MapNode::Material(2),
-            voronoi(0, 2, 1.0, 1),
-            voronoi(2, 1, 0.25, 2),
-            MapNode::Overlay { under: 3, over: 4 },
-            MapNode::Material(3),
-            MapNode::Switch {
-                field: 0,
-                first: 0,
-                count: 2,
-                blend: 0.4,
-            },
-        ];
-        let entry = |cumulative, node| Entry { cumulative, node };
-        let entries = vec![entry(0.5, 0), entry(1.0, 1), entry(1.0, 2)];
-        let mut fields = FieldTable::default();
-        let x = fields.add(FieldNode::Constant(0.0)).unwrap();
-        assert_eq!(x, 0);
-        let stops = vec![
-            Stop {
-                threshold: f32::NEG_INFINITY,
-                node: 5,
-            },
-            Stop {
-                threshold: 0.1,
-                node: 6,
-            },
-        ];
-        Map::new(nodes, entries, stops, fields, 7).unwrap()
+        crate::texture::fixtures::glitter_under_switch(FieldNode::Constant(0.0), 0.1, 0.4)
     }
 
     fn points() -> impl Iterator<Item = (Vec3, f32)> {
