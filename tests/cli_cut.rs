@@ -2,7 +2,9 @@
 //! brilliant cut to diamond's angles keeps the light in diamond (n 2.42) but leaks it through the
 //! pavilion in glass (n 1.5: the pavilion mains at 40.75° lie inside glass's critical angle of
 //! 41.8°, so light from the table passes through them — the "windowing" of a shallow-for-its-index
-//! stone); the report is deterministic for any thread count; bad tilts are refused with the range.
+//! stone); the Oregon sunstone cut with its platelets parallel to the table shows the schiller
+//! face-up and the one cut 30° off does not until tilted; the report is deterministic for any thread
+//! count; bad tilts are refused with the range.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -47,7 +49,7 @@ fn rows(csv: &Path) -> Vec<std::collections::HashMap<String, f64>> {
         .map(|l| {
             head.iter()
                 .zip(l.split(','))
-                .map(|(k, v)| (k.to_string(), v.parse().unwrap()))
+                .map(|(k, v)| (k.to_string(), v.parse().unwrap_or(f64::NAN)))
                 .collect()
         })
         .collect()
@@ -139,5 +141,51 @@ fn bad_tilts_are_refused_with_the_range() {
         assert!(e.contains(want), "{tilts}: {e}");
     }
     assert!(!dir.join("stone-cut.csv").exists(), "nothing written");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// The schiller share: the Oregon sunstone cut with its platelets parallel to the table flashes
+/// face-up and less when tilted; the same stone cut 30° off shows no flash face-up and one when
+/// tilted toward its platelets (each comparison at 5 binomial standard errors).
+#[test]
+fn the_schiller_faces_up_only_in_the_stone_cut_for_it() {
+    let dir = scratch("schiller");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut shares = vec![];
+    for gem in ["oregon-sunstone-faceted", "oregon-sunstone-off-axis"] {
+        let o = Command::new(env!("CARGO_BIN_EXE_lapidary"))
+            .arg("cut")
+            .arg(root.join("gems").join(format!("{gem}.ron")))
+            .args(["--size", "96", "--spp", "1", "--tilts", "0,30", "--out"])
+            .arg(&dir)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let r = rows(&dir.join(format!("{gem}-cut.csv")));
+        shares.push([
+            (r[0]["schiller"], r[0]["schiller_se"]),
+            (r[1]["schiller"], r[1]["schiller_se"]),
+        ]);
+    }
+    println!(
+        "schiller (0°, 30°): face-up cut {:?}, cut 30° off {:?}",
+        shares[0], shares[1]
+    );
+    let more = |a: (f64, f64), b: (f64, f64)| a.0 - b.0 > 5.0 * (a.1 * a.1 + b.1 * b.1).sqrt();
+    let ([up0, up30], [off0, off30]) = (shares[0], shares[1]);
+    assert!(more(up0, off0), "face-up at 0°: {up0:?} vs {off0:?}");
+    assert!(
+        more(up0, up30),
+        "the face-up cut tilted: {up0:?} vs {up30:?}"
+    );
+    assert!(
+        off30.0 > off0.0,
+        "the off-axis cut tilted: {off30:?} vs {off0:?}"
+    );
+    // A stone without platelets has no schiller column value.
+    let plain = stone(&dir, "plain", 1.5);
+    assert!(cut(&plain, &dir, &["--tilts", "0"]).status.success());
+    let text = std::fs::read_to_string(dir.join("plain-cut.csv")).unwrap();
+    assert!(text.lines().nth(1).unwrap().ends_with(",,"), "{text}");
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -1,6 +1,8 @@
 //! `lapidary cut RECIPE [--tilts 0,10,20,30] [--out DIR]`: the stone face-up under the cut
 //! report's lightings ([`report`]) at each tilt — a contact sheet (PNG), a CSV and a table of
-//! light return, the ASET shares and leakage, each with its standard error (issue 39; docs/cuts.md).
+//! light return, the ASET shares and leakage, and for a stone with platelets the share of pixels
+//! showing the schiller flash ([`schiller`]), each with its standard error (issue 39;
+//! docs/cuts.md).
 //!
 //! The stone is seen along −y through an orthographic camera framing its bounds, the floor and
 //! the recipe's lights removed, the environment replaced by the lighting; a tilt turns the stone
@@ -8,6 +10,7 @@
 //! are deterministic: the same recipe, seed and spp give the same report for any thread count.
 
 pub mod report;
+pub mod schiller;
 
 use super::load::load_scene;
 use crate::image::outputs::{Format, OutputPlan};
@@ -75,6 +78,8 @@ struct Row {
     light_return: Estimate,
     cos: Estimate,
     aset: [Estimate; 4],
+    /// The schiller share (a stone with platelets only).
+    schiller: Option<Estimate>,
 }
 
 /// Runs the report.
@@ -107,6 +112,7 @@ pub fn run(args: &CutArgs) -> Result<()> {
                 value: 0.0,
                 se: 0.0,
             }; 4],
+            schiller: None,
         };
         for lighting in Lighting::ALL {
             let env = scratch.0.join(format!("{}.exr", lighting.name()));
@@ -144,7 +150,8 @@ pub fn run(args: &CutArgs) -> Result<()> {
             match lighting {
                 Lighting::Iso => {
                     row.light_return = report::mean_luminance(&film, &mask)
-                        .context("the stone covers no pixel of the view")?
+                        .context("the stone covers no pixel of the view")?;
+                    row.schiller = schiller::share(&world, &scene, &scene.stage.camera, args.size);
                 }
                 Lighting::Cos => row.cos = report::mean_luminance(&film, &mask).unwrap_or(row.cos),
                 Lighting::Aset => row.aset = report::aset_shares(&film, &mask).unwrap_or(row.aset),
@@ -223,20 +230,21 @@ fn contact_sheet(views: &[Vec<[f32; 3]>], rows: u32, size: u32) -> Vec<u8> {
 
 fn table(rows: &[Row]) -> String {
     let mut s = String::from(
-        "tilt   light return (ISO)   COS              ASET red        green           blue            leakage\n",
+        "tilt   light return (ISO)   COS              ASET red        green           blue            leakage         schiller\n",
     );
     let pm = |e: &Estimate| format!("{:.3} ± {:.3}", e.value, e.se);
     for r in rows {
         let _ = writeln!(
             s,
-            "{:>4}°  {:<20} {:<16} {:<15} {:<15} {:<15} {}",
+            "{:>4}°  {:<20} {:<16} {:<15} {:<15} {:<15} {:<15} {}",
             r.tilt,
             pm(&r.light_return),
             pm(&r.cos),
             pm(&r.aset[0]),
             pm(&r.aset[1]),
             pm(&r.aset[2]),
-            pm(&r.aset[3])
+            pm(&r.aset[3]),
+            r.schiller.as_ref().map_or("–".to_string(), pm)
         );
     }
     s
@@ -245,13 +253,18 @@ fn table(rows: &[Row]) -> String {
 fn csv_text(rows: &[Row]) -> String {
     let mut s = String::from(
         "tilt_deg,light_return_iso,light_return_iso_se,cos,cos_se,aset_red,aset_red_se,\
-         aset_green,aset_green_se,aset_blue,aset_blue_se,leakage,leakage_se\n",
+         aset_green,aset_green_se,aset_blue,aset_blue_se,leakage,leakage_se,schiller,schiller_se\n",
     );
     for r in rows {
         let mut cells = vec![r.tilt.to_string()];
         for e in [&r.light_return, &r.cos].into_iter().chain(r.aset.iter()) {
             cells.push(format!("{:.6}", e.value));
             cells.push(format!("{:.6}", e.se));
+        }
+        // Empty cells for a stone without platelets.
+        match &r.schiller {
+            Some(e) => cells.extend([format!("{:.6}", e.value), format!("{:.6}", e.se)]),
+            None => cells.extend([String::new(), String::new()]),
         }
         s += &cells.join(",");
         s.push('\n');
