@@ -1,4 +1,4 @@
-//! Faceted stones: parametric cuts and GemCad designs as half-spaces (issue 39).
+//! Faceted stones: parametric cuts and GemCad designs as half-spaces (docs/cuts.md).
 //!
 //! A cut is a list of planes with names; the stone is the intersection of their half-spaces
 //! ([`crate::geometry::Polytope`]). Conventions: object space, `y` up, the table toward `+y`, the

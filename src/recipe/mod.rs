@@ -24,6 +24,7 @@ pub mod material;
 mod platelet_compiler;
 pub mod platelets;
 mod resolve;
+mod shape;
 pub mod source;
 pub mod spectrum;
 pub mod stage;

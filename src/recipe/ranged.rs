@@ -396,6 +396,13 @@ where
     .map(|b| b.0)
 }
 
+/// Two sizes, each `0 <.. 1e4` ([`sizes_ok`]).
+pub(crate) fn positive2<'de, D: serde::Deserializer<'de>>(d: D) -> Result<(f32, f32), D::Error> {
+    let v = <(f32, f32) as serde::Deserialize>::deserialize(d)?;
+    let mut s = [v.0, v.1];
+    sizes_ok(&mut s, v).map(|()| (s[0], s[1]))
+}
+
 #[cfg(test)]
 mod tests {
     use super::super::surface::{FieldDesc, MapDesc, SwitchDesc};

@@ -1,8 +1,7 @@
 //! `lapidary cut RECIPE [--tilts 0,10,20,30] [--out DIR]`: the stone face-up under the cut
 //! report's lightings ([`report`]) at each tilt — a contact sheet (PNG), a CSV and a table of
 //! light return, the ASET shares and leakage, and for a stone with platelets the share of pixels
-//! showing the schiller flash ([`schiller`]), each with its standard error (issue 39;
-//! docs/cuts.md).
+//! showing the schiller flash ([`schiller`]), each with its standard error (docs/cuts.md).
 //!
 //! The stone is seen along −y through an orthographic camera framing its bounds, the floor and
 //! the recipe's lights removed, the environment replaced by the lighting; a tilt turns the stone

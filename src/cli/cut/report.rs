@@ -1,4 +1,4 @@
-//! The cut report's lightings and measures (`lapidary cut`, issue 39): the stone is seen face-up
+//! The cut report's lightings and measures (`lapidary cut`, docs/cuts.md): the stone is seen face-up
 //! through an orthographic camera, as ASET images are made, under lightings that depend only on
 //! the elevation of the direction light comes from.
 //!

@@ -115,12 +115,15 @@ pub fn png(image: &Image, aov: Aov, tm: &ToneMap) -> Vec<u8> {
 /// The map's cell trail hash at the first hit of every film pixel (`None`: not the stone).
 fn cell_ids(image: &Image) -> Vec<Option<u64>> {
     let (w, h) = (image.film.width, image.film.height);
+    let rays = super::inspect::camera_rays(image);
     (0..h)
         .flat_map(|y| (0..w).map(move |x| (x, y)))
-        .map(|(x, y)| match super::inspect::primary_hit(image, x, y).0 {
-            Some(Hit::Stone(s)) => Some(image.world.map.lookup(s.p_object, 0.5).trail.hash()),
-            _ => None,
-        })
+        .map(
+            |(x, y)| match super::inspect::primary_hit_with(image, &rays, x, y).0 {
+                Some(Hit::Stone(s)) => Some(image.world.map.lookup(s.p_object, 0.5).trail.hash()),
+                _ => None,
+            },
+        )
         .collect()
 }
 

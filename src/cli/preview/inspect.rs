@@ -16,8 +16,22 @@ use serde_json::{Value, json};
 /// The camera ray through the centre of film pixel `(x, y)` of `image`: what it hits first and
 /// its (unit) direction.
 pub(super) fn primary_hit(image: &Image, x: u32, y: u32) -> (Option<Hit>, Vec3) {
+    primary_hit_with(image, &camera_rays(image), x, y)
+}
+
+/// The camera rays of `image`'s film (made once for a whole frame of [`primary_hit_with`]).
+pub(super) fn camera_rays(image: &Image) -> CameraRays {
     let (w, h) = (image.film.width, image.film.height);
-    let rays = CameraRays::new(&image.scene.stage.camera, w, h, false);
+    CameraRays::new(&image.scene.stage.camera, w, h, false)
+}
+
+/// [`primary_hit`] with the film's camera rays made already.
+pub(super) fn primary_hit_with(
+    image: &Image,
+    rays: &CameraRays,
+    x: u32,
+    y: u32,
+) -> (Option<Hit>, Vec3) {
     let ray = rays.ray(Vec2::new(x as f32 + 0.5, y as f32 + 0.5), Vec2::splat(0.5));
     (image.world.intersect(&ray, f32::INFINITY), ray.dir)
 }
