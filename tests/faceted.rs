@@ -440,3 +440,35 @@ fn bad_cuts_and_designs_are_refused_at_their_position() {
     assert!(e.contains("do not close the stone"), "{e}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Tolkowsky's ideal brilliant (*Diamond Design*, 1919, as tabulated in gemmology texts since):
+/// table 53 %, crown angle 34.5°, pavilion angle 40.75°, knife-edge girdle — for which he
+/// published crown height 16.2 %, pavilion depth 43.1 % and total depth 59.3 % of the girdle
+/// diameter (his total has no girdle). The cut measured from its solid (`lapidary info`'s
+/// figures, `cut::metrics`) gives his figures to their printed digits; its girdle is a knife edge
+/// only halfway between the junctions, where a faceted girdle is thinnest, so the solid's total
+/// depth adds the girdle's thickness at the junctions.
+#[test]
+fn tolkowskys_brilliant_has_his_published_proportions() {
+    let b = Brilliant {
+        table: 0.53,
+        girdle: 0.0,
+        ..Brilliant::default()
+    };
+    let f = Cut::Brilliant(b).facets(2.0).unwrap();
+    let p = lapidary::cut::metrics::proportions(&f);
+    let (crown, pavilion) = (p.crown_pct.unwrap(), p.pavilion_pct.unwrap());
+    let (thinnest, thickest) = p.girdle_pct.unwrap();
+    let rounded = |x: f64| (10.0 * x).round() / 10.0;
+    assert_eq!(rounded(crown), 16.2, "crown height {crown}");
+    assert_eq!(rounded(pavilion), 43.1, "pavilion depth {pavilion}");
+    // His total is the sum of his rounded parts (16.15 + 43.08 = 59.23 unrounded).
+    assert!(
+        (crown + pavilion - 59.3).abs() < 0.1,
+        "crown + pavilion {}",
+        crown + pavilion
+    );
+    assert!((p.table_pct.unwrap() - 53.0).abs() < 1e-6);
+    assert!(thinnest.abs() < 1e-6, "knife edge {thinnest}");
+    assert!((p.depth_pct - (crown + pavilion + thickest)).abs() < 1e-6);
+}

@@ -1,7 +1,9 @@
 //! `lapidary cut RECIPE [--tilts 0,10,20,30] [--out DIR]`: the stone face-up under the cut
-//! report's lightings ([`report`]) at each tilt — a contact sheet (PNG), a CSV and a table of
-//! light return, the ASET shares and leakage, and for a stone with platelets the share of pixels
-//! showing the schiller flash ([`schiller`]), each with its standard error (docs/cuts.md).
+//! report's lightings ([`report`]: ISO, COS, ASET; [`sparkle`]: the spots) at each tilt — a
+//! contact sheet (PNG), a CSV and tables of light return, the ASET shares and leakage,
+//! extinction, contrast, fire, sparkles and scintillation, and for a stone with platelets the
+//! share of pixels showing the schiller flash ([`schiller`]), each with its standard error
+//! (docs/cuts.md).
 //!
 //! The stone is seen along −y through an orthographic camera framing its bounds, the floor and
 //! the recipe's lights removed, the environment replaced by the lighting; a tilt turns the stone
@@ -10,6 +12,8 @@
 
 pub mod report;
 pub mod schiller;
+pub mod sparkle;
+mod table;
 
 use super::load::load_scene;
 use crate::image::outputs::{Format, OutputPlan};
@@ -22,7 +26,6 @@ use anyhow::{Context as _, Result, bail};
 use clap::Args;
 use glam::{Vec2, Vec3};
 use report::{Estimate, Lighting};
-use std::fmt::Write as _;
 use std::path::PathBuf;
 
 /// Most tilts one report renders.
@@ -77,8 +80,43 @@ struct Row {
     light_return: Estimate,
     cos: Estimate,
     aset: [Estimate; 4],
+    extinction: Estimate,
+    contrast: Estimate,
+    fire: Estimate,
+    /// The number of sparkles; its error from the two independent halves' counts.
+    sparkles: Estimate,
+    /// Share of the stone's pixels that sparkle.
+    sparkling: Estimate,
+    scintillation: Estimate,
     /// The schiller share (a stone with platelets only).
     schiller: Option<Estimate>,
+}
+
+/// What lights one view.
+#[derive(Clone, Copy)]
+enum Light {
+    /// One of the environment lightings.
+    Sky(Lighting),
+    /// The spots on a black sky.
+    Spots,
+}
+
+/// The pixel-wise mean of two renders of one view.
+fn mean_rgb(a: &crate::render::film::Film, b: &crate::render::film::Film) -> Vec<[f32; 3]> {
+    a.rgb()
+        .iter()
+        .zip(b.rgb())
+        .map(|(p, q)| [0, 1, 2].map(|k| 0.5 * (p[k] + q[k])))
+        .collect()
+}
+
+/// One rendered view of the stone.
+struct Shot {
+    world: World,
+    scene: crate::scene::Scene,
+    film: crate::render::film::Film,
+    /// The pixels whose camera ray meets the stone.
+    mask: Vec<bool>,
 }
 
 /// Runs the report.
@@ -96,78 +134,81 @@ pub fn run(args: &CutArgs) -> Result<()> {
     let scratch = Scratch::new()?;
     let mut sheet: Vec<Vec<[f32; 3]>> = vec![];
     let mut rows = vec![];
+    let none = || "the stone covers no pixel of the view";
+    // Fire is dispersion's: a stone without it has none.
+    let dispersive = loaded
+        .scene
+        .surface
+        .body
+        .as_ref()
+        .is_some_and(|b| b.dispersion.is_some());
     for &tilt in &args.tilts.0 {
-        let mut row = Row {
+        let shoot_at = |light, tilt, twin| shoot(&loaded.scene, light, tilt, twin, args, &scratch);
+        let shoot = |light, twin| shoot_at(light, tilt, twin);
+        // The ISO and spot views twice, independently: their contrast and fire need two.
+        let iso = shoot(Light::Sky(Lighting::Iso), false)?;
+        let iso_twin = shoot(Light::Sky(Lighting::Iso), true)?;
+        let cos = shoot(Light::Sky(Lighting::Cos), false)?;
+        let aset = shoot(Light::Sky(Lighting::Aset), false)?;
+        let spots = shoot(Light::Spots, false)?;
+        let spots_twin = shoot(Light::Spots, true)?;
+        let tilted = shoot_at(Light::Spots, tilt + sparkle::TILT_STEP, false)?;
+        let tilted_twin = shoot_at(Light::Spots, tilt + sparkle::TILT_STEP, true)?;
+        let iso_view = mean_rgb(&iso.film, &iso_twin.film);
+        let spot_view = mean_rgb(&spots.film, &spots_twin.film);
+        let on = sparkle::sparkling(&spot_view, &spots.mask);
+        let on_tilted =
+            sparkle::sparkling(&mean_rgb(&tilted.film, &tilted_twin.film), &tilted.mask);
+        let light_return = [&iso, &iso_twin].map(|s| report::mean_luminance(&s.film, &s.mask));
+        rows.push(Row {
             tilt,
-            light_return: Estimate {
-                value: 0.0,
-                se: 0.0,
-            },
-            cos: Estimate {
-                value: 0.0,
-                se: 0.0,
-            },
-            aset: [Estimate {
-                value: 0.0,
-                se: 0.0,
-            }; 4],
-            schiller: None,
-        };
-        for lighting in Lighting::ALL {
-            let env = scratch.0.join(format!("{}.exr", lighting.name()));
-            if !env.exists() {
-                crate::image::write_exr(&env, &exr_of(&lighting.environment()))?;
-            }
-            let mut scene = loaded.scene.clone();
-            let st = &mut scene.stage;
-            st.ground = None;
-            st.lights.clear();
-            st.environment = Environment::Map {
-                path: env,
-                intensity: 1.0,
-                rotate: 0.0,
-            };
-            View {
-                tilt_x: tilt,
-                ..View::default()
-            }
-            .apply(st);
-            scene.stage.camera = face_up(&scene)?;
-            let r = &mut scene.stage.render;
-            (r.width, r.height, r.spp) = (args.size, args.size, args.spp);
-            scene.effects.turn_on(
-                crate::scene::Effect::EnvironmentImportance,
-                "lapidary cut's lighting",
-            );
-            let world = World::new(&scene).context("building the stone")?;
-            let control = Control {
-                threads: args.threads.map(|t| t as usize),
-                ..Control::default()
-            };
-            let film = render_scene(&world, &scene, &control).film;
-            let mask = stone_mask(&world, &scene.stage.camera, args.size);
-            match lighting {
-                Lighting::Iso => {
-                    row.light_return = report::mean_luminance(&film, &mask)
-                        .context("the stone covers no pixel of the view")?;
-                    row.schiller = schiller::share(&world, &scene, &scene.stage.camera, args.size);
+            light_return: Estimate::mean_of(light_return).context(none())?,
+            cos: report::mean_luminance(&cos.film, &cos.mask).context(none())?,
+            aset: report::aset_shares(&aset.film, &aset.mask).context(none())?,
+            extinction: report::extinction(&iso_view, &iso.mask).context(none())?,
+            contrast: report::contrast([&iso.film, &iso_twin.film], &iso.mask).context(none())?,
+            fire: if dispersive {
+                sparkle::fire([&spots.film, &spots_twin.film], &spots.mask).context(none())?
+            } else {
+                Estimate {
+                    value: 0.0,
+                    se: 0.0,
                 }
-                Lighting::Cos => row.cos = report::mean_luminance(&film, &mask).unwrap_or(row.cos),
-                Lighting::Aset => row.aset = report::aset_shares(&film, &mask).unwrap_or(row.aset),
-            }
-            sheet.push(film.rgb());
-        }
-        rows.push(row);
+            },
+            sparkles: {
+                let half = |f: &crate::render::film::Film| {
+                    f64::from(sparkle::count_sparkles(
+                        &sparkle::sparkling(&f.rgb(), &spots.mask),
+                        args.size,
+                    ))
+                };
+                Estimate {
+                    value: f64::from(sparkle::count_sparkles(&on, args.size)),
+                    se: 0.5 * (half(&spots.film) - half(&spots_twin.film)).abs(),
+                }
+            },
+            sparkling: sparkle::share(&on, &spots.mask).context(none())?,
+            scintillation: sparkle::scintillation(
+                &on,
+                &on_tilted,
+                &spots.mask,
+                &tilted.mask,
+                sparkle::TILT_STEP,
+            )
+            .context(none())?,
+            schiller: schiller::share(&iso.world, &iso.scene, &iso.scene.stage.camera, args.size),
+        });
+        sheet.extend([iso_view, cos.film.rgb(), aset.film.rgb(), spot_view]);
     }
-    let table = table(&rows);
+    let table = table::table(&rows);
     print!("{table}");
     let (n, size) = (rows.len() as u32, args.size);
     let bytes = contact_sheet(&sheet, n, size);
     crate::image::atomic::all_or_nothing(|| {
-        crate::image::png::write_rgb8(&png, 3 * size, n * size, bytes)?;
+        crate::image::png::write_rgb8(&png, COLUMNS * size, n * size, bytes)?;
         crate::image::atomic::write_atomically(&csv, |w| {
             use std::io::Write as _;
-            w.write_all(csv_text(&rows).as_bytes())?;
+            w.write_all(table::csv_text(&rows).as_bytes())?;
             Ok(())
         })?;
         Ok(())
@@ -176,14 +217,109 @@ pub fn run(args: &CutArgs) -> Result<()> {
     Ok(())
 }
 
-/// An orthographic camera straight down onto the stone, framing its bounds with a margin.
-fn face_up(scene: &crate::scene::Scene) -> Result<Camera> {
+/// Renders the stone of `scene` face-up at `tilt` degrees under `light`; a `twin` with other
+/// random numbers than the view rendered without.
+fn shoot(
+    scene: &crate::scene::Scene,
+    light: Light,
+    tilt: f32,
+    twin: bool,
+    args: &CutArgs,
+    scratch: &Scratch,
+) -> Result<Shot> {
+    let mut scene = scene.clone();
+    let st = &mut scene.stage;
+    st.ground = None;
+    st.lights.clear();
+    View {
+        tilt_x: tilt,
+        ..View::default()
+    }
+    .apply(st);
+    let frame = frame(&scene)?;
+    match light {
+        Light::Sky(lighting) => {
+            let env = scratch.0.join(format!("{}.exr", lighting.name()));
+            if !env.exists() {
+                crate::image::write_exr(&env, &exr_of(&lighting.environment()))?;
+            }
+            scene.stage.environment = Environment::Map {
+                path: env,
+                intensity: 1.0,
+                rotate: 0.0,
+            };
+        }
+        Light::Spots => {
+            let env = scratch.0.join("spots.exr");
+            if !env.exists() {
+                crate::image::write_exr(&env, &exr_of(&sparkle::spot_map()))?;
+            }
+            scene.stage.environment = Environment::Map {
+                path: env,
+                intensity: 1.0,
+                rotate: 0.0,
+            };
+        }
+    }
+    scene.effects.turn_on(
+        crate::scene::Effect::EnvironmentImportance,
+        "lapidary cut's lighting",
+    );
+    scene.stage.camera = face_up(&frame)?;
+    let r = &mut scene.stage.render;
+    (r.width, r.height, r.spp) = (args.size, args.size, args.spp);
+    if twin {
+        // Any other seed gives independent sample sequences.
+        r.seed = r.seed.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    }
+    let world = World::new(&scene).context("building the stone")?;
+    let control = Control {
+        threads: args.threads.map(|t| t as usize),
+        ..Control::default()
+    };
+    let film = render_scene(&world, &scene, &control).film;
+    let mask = stone_mask(&world, &scene.stage.camera, args.size);
+    Ok(Shot {
+        world,
+        scene,
+        film,
+        mask,
+    })
+}
+
+/// Where the stone is, in world space.
+struct Frame {
+    /// The centre of its bounds.
+    centre: Vec3,
+    /// The larger of its horizontal extents.
+    extent: f32,
+    /// The height of its top.
+    top: f32,
+}
+
+fn frame(scene: &crate::scene::Scene) -> Result<Frame> {
     let stone = crate::geometry::Stone::new(&scene.stage.shape, scene.stage.to_world)
         .context("building the stone")?;
     let (lo, hi) = stone.bounds();
-    let centre = 0.5 * (lo + hi);
     let extent = (hi.x - lo.x).max(hi.z - lo.z);
-    let from = Vec3::new(centre.x, hi.y + 2.0 * extent + 1.0, centre.z);
+    if !(extent > 0.0 && extent.is_finite()) {
+        bail!("the stone has no extent to frame");
+    }
+    Ok(Frame {
+        centre: 0.5 * (lo + hi),
+        extent,
+        top: hi.y,
+    })
+}
+
+/// An orthographic camera straight down onto the stone, framing its extent with a margin.
+fn face_up(frame: &Frame) -> Result<Camera> {
+    let Frame {
+        centre,
+        extent,
+        top,
+    } = *frame;
+    let from = Vec3::new(centre.x, top + 2.0 * extent + 1.0, centre.z);
     let Some(camera) = Camera::look_at(
         from,
         centre,
@@ -209,12 +345,15 @@ fn stone_mask(world: &World, camera: &Camera, size: u32) -> Vec<bool> {
         .collect()
 }
 
-/// Rows: tilts; columns: ISO, COS, ASET (each view `size` square, clamped to [0, 1], sRGB).
+/// Views per row of the contact sheet.
+const COLUMNS: u32 = 4;
+
+/// Rows: tilts; columns: ISO, COS, ASET, spots (each view `size` square, clamped to [0, 1], sRGB).
 fn contact_sheet(views: &[Vec<[f32; 3]>], rows: u32, size: u32) -> Vec<u8> {
-    let w = 3 * size;
+    let w = COLUMNS * size;
     let mut out = vec![0u8; (3 * w * rows * size) as usize];
     for (k, view) in views.iter().enumerate() {
-        let (r, c) = (k as u32 / 3, k as u32 % 3);
+        let (r, c) = (k as u32 / COLUMNS, k as u32 % COLUMNS);
         for (i, px) in view.iter().enumerate() {
             let (x, y) = (c * size + i as u32 % size, r * size + i as u32 / size);
             let at = (3 * (y * w + x)) as usize;
@@ -225,50 +364,6 @@ fn contact_sheet(views: &[Vec<[f32; 3]>], rows: u32, size: u32) -> Vec<u8> {
         }
     }
     out
-}
-
-fn table(rows: &[Row]) -> String {
-    let mut s = String::from(
-        "tilt   light return (ISO)   COS              ASET red        green           blue            leakage         schiller\n",
-    );
-    let pm = |e: &Estimate| format!("{:.3} ± {:.3}", e.value, e.se);
-    for r in rows {
-        let _ = writeln!(
-            s,
-            "{:>4}°  {:<20} {:<16} {:<15} {:<15} {:<15} {:<15} {}",
-            r.tilt,
-            pm(&r.light_return),
-            pm(&r.cos),
-            pm(&r.aset[0]),
-            pm(&r.aset[1]),
-            pm(&r.aset[2]),
-            pm(&r.aset[3]),
-            r.schiller.as_ref().map_or("–".to_string(), pm)
-        );
-    }
-    s
-}
-
-fn csv_text(rows: &[Row]) -> String {
-    let mut s = String::from(
-        "tilt_deg,light_return_iso,light_return_iso_se,cos,cos_se,aset_red,aset_red_se,\
-         aset_green,aset_green_se,aset_blue,aset_blue_se,leakage,leakage_se,schiller,schiller_se\n",
-    );
-    for r in rows {
-        let mut cells = vec![r.tilt.to_string()];
-        for e in [&r.light_return, &r.cos].into_iter().chain(r.aset.iter()) {
-            cells.push(format!("{:.6}", e.value));
-            cells.push(format!("{:.6}", e.se));
-        }
-        // Empty cells for a stone without platelets.
-        match &r.schiller {
-            Some(e) => cells.extend([format!("{:.6}", e.value), format!("{:.6}", e.se)]),
-            None => cells.extend([String::new(), String::new()]),
-        }
-        s += &cells.join(",");
-        s.push('\n');
-    }
-    s
 }
 
 /// An RGB image as an EXR of channels R, G, B.

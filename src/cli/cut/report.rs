@@ -16,8 +16,10 @@
 //! return** — the mean luminance under ISO over the mean the lighting gives outside the head
 //! shadow (1), BOG's brightness in kind; its standard error from the renders' per-pixel variance;
 //! **ASET shares** — the fraction of stone pixels whose ASET colour is mostly blue, red or green,
-//! and **leakage**, the fraction that is dark (luminance below [`DARK`]), each with the binomial
-//! standard error over the stone's pixels.
+//! and **leakage**, the fraction that is dark (luminance below [`DARK`]); **extinction**, the
+//! fraction darker than [`EXTINCT`] under ISO; **contrast**, the RMS contrast under ISO — shares
+//! with binomial standard errors, the contrast with a jackknife's. The spot lighting's fire and
+//! scintillation are in [`super::sparkle`].
 
 use crate::image::RgbImage;
 use crate::render::film::Film;
@@ -28,6 +30,10 @@ pub const HEAD_HALF_ANGLE: f64 = 20.0;
 
 /// Luminance below which an ASET pixel counts as dark (leakage).
 pub const DARK: f64 = 0.05;
+
+/// Luminance, as a share of the ISO lighting, below which a pixel counts as extinct (GUESS: a
+/// quarter, where a facet reads as dark beside its neighbours).
+pub const EXTINCT: f64 = 0.25;
 
 /// The report's lightings.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -99,8 +105,107 @@ pub struct Estimate {
     pub se: f64,
 }
 
-fn luminance(c: [f32; 3]) -> f64 {
+/// Rec. 709 luminance of a linear RGB colour.
+pub fn luminance(c: [f32; 3]) -> f64 {
     0.2126 * f64::from(c[0]) + 0.7152 * f64::from(c[1]) + 0.0722 * f64::from(c[2])
+}
+
+impl Estimate {
+    /// The mean of two independent estimates of one quantity; `None` if either is.
+    pub fn mean_of(e: [Option<Estimate>; 2]) -> Option<Estimate> {
+        let [a, b] = e;
+        let (a, b) = (a?, b?);
+        Some(Estimate {
+            value: 0.5 * (a.value + b.value),
+            se: 0.5 * a.se.hypot(b.se),
+        })
+    }
+
+    /// A share `p` of `n` pixels with its binomial standard error.
+    pub fn binomial(p: f64, n: usize) -> Estimate {
+        Estimate {
+            value: p,
+            se: (p * (1.0 - p) / n.max(1) as f64).sqrt(),
+        }
+    }
+}
+
+/// Groups the jackknife splits the pixels into.
+const GROUPS: usize = 20;
+
+/// `statistic` of `values` with its standard error by the delete-a-group jackknife (Efron &
+/// Tibshirani, *An Introduction to the Bootstrap*, 1993, §11.5) over [`GROUPS`] interleaved groups
+/// of the values (pixels `i ≡ g mod GROUPS`): for statistics of many pixels that are not plain
+/// means.
+pub fn jackknife<T: Copy>(values: &[T], statistic: impl Fn(&[T]) -> f64) -> Estimate {
+    let value = statistic(values);
+    let g = GROUPS.min(values.len());
+    if g < 2 {
+        return Estimate { value, se: 0.0 };
+    }
+    let leave_out: Vec<f64> = (0..g)
+        .map(|k| {
+            let rest: Vec<T> = values
+                .iter()
+                .enumerate()
+                .filter(|(i, _)| i % g != k)
+                .map(|(_, &v)| v)
+                .collect();
+            statistic(&rest)
+        })
+        .collect();
+    let mean = leave_out.iter().sum::<f64>() / g as f64;
+    let var = leave_out.iter().map(|t| (t - mean).powi(2)).sum::<f64>() * (g - 1) as f64 / g as f64;
+    Estimate {
+        value,
+        se: var.sqrt(),
+    }
+}
+
+/// The **extinction** of an ISO view (its linear RGB pixels): the share of the stone's pixels
+/// darker than [`EXTINCT`] of the lighting (the head's shadow and leaked light seen in the
+/// stone), binomial standard error.
+pub fn extinction(rgb: &[[f32; 3]], mask: &[bool]) -> Option<Estimate> {
+    let lum: Vec<f64> = rgb
+        .iter()
+        .zip(mask)
+        .filter(|(_, m)| **m)
+        .map(|(&c, _)| luminance(c))
+        .collect();
+    (!lum.is_empty()).then(|| {
+        let dark = lum.iter().filter(|&&l| l < EXTINCT).count();
+        Estimate::binomial(dark as f64 / lum.len() as f64, lum.len())
+    })
+}
+
+/// The **contrast** of an ISO view from two independent renders of it: the RMS contrast of the
+/// stone's pixels — the standard deviation of their luminance over its mean (Peli, "Contrast in
+/// complex images", JOSA A 7(10), 1990) — with a jackknife standard error over groups of pixels.
+/// The variance is the mean product of the two renders' deviations from their means, which
+/// render noise does not inflate (the renders are independent), so the contrast does not depend
+/// on the samples per pixel.
+pub fn contrast(halves: [&Film; 2], mask: &[bool]) -> Option<Estimate> {
+    let pixels: Vec<[f64; 2]> = (0..mask.len())
+        .filter(|&i| mask[i])
+        .map(|i| halves.map(|f| luminance(f.pixels[i].mean().0)))
+        .collect();
+    (!pixels.is_empty()).then(|| {
+        jackknife(&pixels, |px| {
+            let n = px.len().max(1) as f64;
+            let m = [0, 1].map(|k| px.iter().map(|p| p[k]).sum::<f64>() / n);
+            let var = px
+                .iter()
+                .map(|p| (p[0] - m[0]) * (p[1] - m[1]))
+                .sum::<f64>()
+                / n;
+            let mean = 0.5 * (m[0] + m[1]);
+            if mean > 0.0 {
+                var.max(0.0).sqrt() / mean
+            } else {
+                0.0
+            }
+        })
+    })
 }
 
 /// Mean luminance of `film` over the pixels of `mask`, with its standard error from each pixel's
