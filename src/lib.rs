@@ -41,6 +41,7 @@ pub mod image;
 pub mod light;
 pub mod medium;
 pub mod platelet;
+pub mod polarisation;
 pub mod recipe;
 pub mod render;
 pub mod sampler;

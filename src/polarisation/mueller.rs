@@ -1,0 +1,157 @@
+//! Mueller matrices: composition, frame rotations, ideal polarisers and retarders, and the matrix
+//! of a Jones matrix.
+
+use super::Stokes;
+use glam::DVec3;
+use num_complex::Complex64;
+
+/// A 4 × 4 Mueller matrix, row-major (see the module docs of [`super`] for frames).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Mueller(pub [[f64; 4]; 4]);
+
+impl Mueller {
+    /// The identity: light passes unchanged.
+    pub const IDENTITY: Mueller = Mueller([
+        [1.0, 0.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0, 0.0],
+        [0.0, 0.0, 1.0, 0.0],
+        [0.0, 0.0, 0.0, 1.0],
+    ]);
+
+    /// A depolarising element of transmittance `t`: its output is unpolarised (the course's model
+    /// of a layered material).
+    pub fn depolariser(t: f64) -> Mueller {
+        let mut m = [[0.0; 4]; 4];
+        m[0][0] = t;
+        Mueller(m)
+    }
+
+    /// The light leaving this element when `s` enters it.
+    pub fn apply(&self, s: Stokes) -> Stokes {
+        Stokes(std::array::from_fn(|i| {
+            (0..4).map(|j| self.0[i][j] * s.0[j]).sum()
+        }))
+    }
+
+    /// `self · other`: `other` acts first.
+    pub fn then_after(&self, other: &Mueller) -> Mueller {
+        Mueller(std::array::from_fn(|i| {
+            std::array::from_fn(|j| (0..4).map(|k| self.0[i][k] * other.0[k][j]).sum())
+        }))
+    }
+
+    /// Re-expresses a Stokes vector in a frame whose `x` axis is the old one turned by `angle`
+    /// radians toward `y` (Collett 2005, eq. 2.47): `S1, S2` turn by `2 angle`.
+    pub fn rotator(angle: f64) -> Mueller {
+        let (s, c) = (2.0 * angle).sin_cos();
+        Mueller([
+            [1.0, 0.0, 0.0, 0.0],
+            [0.0, c, s, 0.0],
+            [0.0, -s, c, 0.0],
+            [0.0, 0.0, 0.0, 1.0],
+        ])
+    }
+
+    /// The rotator from a frame with axis `from_x` to one with axis `to_x`, both unit and
+    /// orthogonal to the propagation direction `d` (unit).
+    pub fn frame_change(from_x: DVec3, to_x: DVec3, d: DVec3) -> Mueller {
+        let angle = from_x.cross(to_x).dot(d).atan2(from_x.dot(to_x));
+        Mueller::rotator(angle)
+    }
+
+    /// An ideal linear polariser whose transmission axis lies at `angle` radians from `x`.
+    pub fn linear_polariser(angle: f64) -> Mueller {
+        let p = Mueller([
+            [0.5, 0.5, 0.0, 0.0],
+            [0.5, 0.5, 0.0, 0.0],
+            [0.0, 0.0, 0.0, 0.0],
+            [0.0, 0.0, 0.0, 0.0],
+        ]);
+        Mueller::rotator(-angle)
+            .then_after(&p)
+            .then_after(&Mueller::rotator(angle))
+    }
+
+    /// The Mueller matrix of the diagonal Jones matrix `diag(jx, jy)` (amplitudes along `x` and
+    /// `y`): Collett 2005, eq. 4.38. `C = Re(jx jy*)` couples `S2, S3` as a retarder of phase
+    /// `arg(jx jy*)`; `A ± B` are the intensity transmittances along `x` and `y`.
+    pub fn diagonal_jones(jx: Complex64, jy: Complex64) -> Mueller {
+        let (x2, y2) = (jx.norm_sqr(), jy.norm_sqr());
+        let (a, b) = (0.5 * (x2 + y2), 0.5 * (x2 - y2));
+        let z = jx * jy.conj();
+        let (c, s) = (z.re, z.im);
+        Mueller([
+            [a, b, 0.0, 0.0],
+            [b, a, 0.0, 0.0],
+            [0.0, 0.0, c, s],
+            [0.0, 0.0, -s, c],
+        ])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::{FRAC_PI_2, PI};
+
+    /// Malus's law: unpolarised light through two polarisers at `θ` to each other keeps
+    /// `½ cos² θ` of its intensity, and leaves polarised along the second.
+    #[test]
+    fn malus_law_through_two_polarisers() {
+        for k in 0..=36 {
+            let theta = PI * k as f64 / 36.0;
+            for first in [0.0, 0.4, 1.3] {
+                let out = Mueller::linear_polariser(first + theta)
+                    .then_after(&Mueller::linear_polariser(first))
+                    .apply(Stokes::unpolarised(1.0));
+                let want = 0.5 * theta.cos().powi(2);
+                assert!((out.intensity() - want).abs() < 1e-12, "θ {theta}: {out:?}");
+                if want > 1e-9 {
+                    let along = Stokes::linear(out.intensity(), first + theta);
+                    for i in 0..4 {
+                        assert!((out.0[i] - along.0[i]).abs() < 1e-12, "{out:?} {along:?}");
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn rotating_the_frame_turns_linear_polarisation_back() {
+        let s = Stokes::linear(1.0, 0.3);
+        // In a frame turned by 0.3 the light lies along the new x.
+        let r = Mueller::rotator(0.3).apply(s);
+        assert!((r.0[1] - 1.0).abs() < 1e-12 && r.0[2].abs() < 1e-12);
+        // A quarter turn swaps x and y.
+        let q = Mueller::rotator(FRAC_PI_2).apply(Stokes::linear(1.0, 0.0));
+        assert!((q.0[1] + 1.0).abs() < 1e-12);
+        // In 3D: from x to y about z is a quarter turn.
+        let m = Mueller::frame_change(DVec3::X, DVec3::Y, DVec3::Z);
+        let q3 = m.apply(Stokes::linear(1.0, 0.0));
+        assert!((q3.0[1] + 1.0).abs() < 1e-12);
+        // Turning there and back is the identity.
+        let back = Mueller::frame_change(DVec3::Y, DVec3::X, DVec3::Z).then_after(&m);
+        for i in 0..4 {
+            for j in 0..4 {
+                assert!((back.0[i][j] - Mueller::IDENTITY.0[i][j]).abs() < 1e-12);
+            }
+        }
+    }
+
+    #[test]
+    fn a_quarter_wave_retarder_makes_45_degree_light_circular() {
+        // Jones diag(1, i): y leads x by 90°; with the e^{−iωt} convention of the module docs the
+        // output is circular with |S3| = 1.
+        let m = Mueller::diagonal_jones(Complex64::new(1.0, 0.0), Complex64::new(0.0, 1.0));
+        let out = m.apply(Stokes::linear(1.0, PI / 4.0));
+        assert!(
+            (out.0[3].abs() - 1.0).abs() < 1e-12 && out.0[1].abs() < 1e-12,
+            "{out:?}"
+        );
+        assert!((out.degree() - 1.0).abs() < 1e-12);
+        assert_eq!(
+            Mueller::depolariser(0.5).apply(out),
+            Stokes::unpolarised(0.5)
+        );
+    }
+}
