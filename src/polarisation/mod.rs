@@ -1,8 +1,10 @@
-//! Polarised light: Stokes vectors, Mueller matrices and the Fresnel matrices of dielectric and
-//! conductor interfaces — the building blocks of a polarised spectral transport (docs/design.md,
-//! "Crystal optics"). Nothing in the renderer uses them yet; they are tested against closed forms
-//! (Malus's law, Brewster's angle, the retardance of total internal reflection, energy balance
-//! and the scalar Fresnel equations of [`crate::bsdf::fresnel`]).
+//! Polarised light and crystal optics: Stokes vectors, Mueller matrices, the Fresnel matrices of
+//! dielectric and conductor interfaces, and refraction into a uniaxial crystal — the building
+//! blocks of a polarised spectral transport with birefringence. Nothing in the renderer uses them
+//! yet; they are tested against closed forms (Malus's law, Brewster's angle, the retardance of
+//! total internal reflection and Fresnel's rhomb, energy balance, the scalar Fresnel equations
+//! of [`crate::bsdf::fresnel`], Snell's law for the ordinary wave and the index ellipsoid's
+//! walk-off for the extraordinary one).
 //!
 //! # Conventions
 //!
@@ -22,6 +24,7 @@
 
 pub mod fresnel;
 pub mod mueller;
+pub mod uniaxial;
 
 pub use mueller::Mueller;
 
