@@ -23,6 +23,7 @@
 //!   polarisation whose `y` component lags.
 
 pub mod fresnel;
+pub mod interference;
 pub mod mueller;
 pub mod uniaxial;
 

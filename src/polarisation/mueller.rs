@@ -72,6 +72,17 @@ impl Mueller {
             .then_after(&Mueller::rotator(angle))
     }
 
+    /// An ideal linear retarder: the polarisation along its slow axis, at `axis` radians from `x`,
+    /// lags the one across it by `delta` radians (a birefringent plate of retardation
+    /// `δ = 2π d Δn / λ`).
+    pub fn linear_retarder(delta: f64, axis: f64) -> Mueller {
+        let jones =
+            Mueller::diagonal_jones(Complex64::new(1.0, 0.0), Complex64::from_polar(1.0, delta));
+        Mueller::rotator(-axis)
+            .then_after(&jones)
+            .then_after(&Mueller::rotator(axis))
+    }
+
     /// The Mueller matrix of the diagonal Jones matrix `diag(jx, jy)` (amplitudes along `x` and
     /// `y`): Collett 2005, eq. 4.38. `C = Re(jx jy*)` couples `S2, S3` as a retarder of phase
     /// `arg(jx jy*)`; `A ± B` are the intensity transmittances along `x` and `y`.
