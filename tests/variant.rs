@@ -104,6 +104,9 @@ impl Spectral for Grey4 {
     fn splat(v: f32) -> Self {
         Grey4([v; 4])
     }
+    fn from_channels(f: impl Fn(usize) -> f32) -> Self {
+        Grey4(std::array::from_fn(f))
+    }
     fn sample_wavelengths(u: f32) -> [f32; 4] {
         std::array::from_fn(|k| 360.0 + 470.0 * (u + k as f32 / 4.0).fract())
     }
@@ -162,6 +165,12 @@ impl Scatter<Grey4> for Bsdf {
     }
     fn pdf_at(&self, wo: Vec3, wi: Vec3, _: &[f32; 4]) -> f32 {
         Bxdf::<RgbSample>::pdf(self, wo, wi)
+    }
+    fn interface_eta(&self, _channel: usize, _: &[f32; 4]) -> Option<f32> {
+        match self {
+            Bsdf::SmoothDielectric(b) => Some(b.eta),
+            _ => None,
+        }
     }
 }
 

@@ -56,6 +56,11 @@ pub trait Scatter<S: Spectral> {
     ) -> Option<BsdfSample<S>>;
     /// Density of `wi` from `wo` ([`Bxdf::pdf`]), for the hero wavelength's sampling.
     fn pdf_at(&self, wo: Vec3, wi: Vec3, lambda: &S::Wavelengths) -> f32;
+    /// For a smooth dielectric interface, its relative IOR (below over above) at the wavelength
+    /// of `channel`; `None` for every other model and for a channel the path no longer carries
+    /// (what polarised transport turns into Fresnel's Mueller matrices,
+    /// [`crate::polarisation::transport`]).
+    fn interface_eta(&self, channel: usize, lambda: &S::Wavelengths) -> Option<f32>;
 }
 
 impl Scatter<RgbSample> for Bsdf {
@@ -77,6 +82,13 @@ impl Scatter<RgbSample> for Bsdf {
     #[inline]
     fn pdf_at(&self, wo: Vec3, wi: Vec3, _: &RgbWavelengths) -> f32 {
         Bxdf::<RgbSample>::pdf(self, wo, wi)
+    }
+    #[inline]
+    fn interface_eta(&self, _channel: usize, _: &RgbWavelengths) -> Option<f32> {
+        match self {
+            Bsdf::SmoothDielectric(b) => Some(b.eta),
+            _ => None,
+        }
     }
 }
 
@@ -202,6 +214,17 @@ impl Scatter<HeroSample> for Bsdf {
                 None => b.pdf(wo, wi),
             },
             _ => Bxdf::<RgbSample>::pdf(self, wo, wi),
+        }
+    }
+
+    fn interface_eta(&self, channel: usize, lambda: &HeroWavelengths) -> Option<f32> {
+        match self {
+            Bsdf::SmoothDielectric(_) if !(lambda.pdf[channel] > 0.0) => None,
+            Bsdf::SmoothDielectric(b) => Some(match b.dispersion {
+                None => b.eta,
+                Some(law) => law.eta_at(lambda.lambda[channel]),
+            }),
+            _ => None,
         }
     }
 }

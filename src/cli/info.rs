@@ -345,10 +345,14 @@ pub fn describe(recipe: &GemRecipe, scene: &Scene, points: u32) -> String {
         };
         let _ = writeln!(
             o,
-            "  light {i}      {shape} at {:.2?}, radiance {:.2?}{}",
+            "  light {i}      {shape} at {:.2?}, radiance {:.2?}{}{}",
             l.center.to_array(),
             l.radiance.0,
-            if l.two_sided { ", two-sided" } else { "" }
+            if l.two_sided { ", two-sided" } else { "" },
+            l.polariser.map_or(String::new(), |a| format!(
+                ", behind a linear polariser (axis {:.3?}: passes half, polarised)",
+                a.to_array()
+            ))
         );
     }
     let cam = &st.camera;
@@ -365,9 +369,13 @@ pub fn describe(recipe: &GemRecipe, scene: &Scene, points: u32) -> String {
     };
     let _ = writeln!(
         o,
-        "  camera       {proj}, from {:.2?} looking {:.3?}",
+        "  camera       {proj}, from {:.2?} looking {:.3?}{}",
         cam.from.to_array(),
-        cam.forward.to_array()
+        cam.forward.to_array(),
+        st.analyser.map_or(String::new(), |a| format!(
+            ", through a linear analyser at {:.1}° from the image's right",
+            a.to_degrees()
+        ))
     );
     let r = &st.render;
     let _ = writeln!(

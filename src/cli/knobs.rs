@@ -50,6 +50,13 @@ pub struct KnobArgs {
     #[arg(long, num_args = 0..=1, default_missing_value = "on",
           value_parser = |s: &str| alias_arg(Effect::Spectral, s))]
     spectral: Option<(Effect, bool)>,
+    /// Polarised transport (each path carries its sensor's Stokes row; smooth dielectric
+    /// boundaries act by Fresnel's Mueller matrices) for a scene without a polariser, or
+    /// `off` to ignore the stage's polarisers: `--polarised` alone is `on` (same as
+    /// `--effect polarisation=…`).
+    #[arg(long, num_args = 0..=1, default_missing_value = "on",
+          value_parser = |s: &str| alias_arg(Effect::Polarisation, s))]
+    polarised: Option<(Effect, bool)>,
     /// Force any effect's code on or off, e.g. `--effect depth-of-field=off` (repeatable;
     /// `lapidary info` lists the effects).
     #[arg(long = "effect", value_parser = effect_arg)]
@@ -77,6 +84,7 @@ impl KnobArgs {
             ("absorption", self.absorption),
             ("bump", self.bump),
             ("spectral", self.spectral),
+            ("polarised", self.polarised),
         ];
         let onoff = |on: bool| if on { "on" } else { "off" };
         let given = aliases

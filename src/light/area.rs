@@ -69,6 +69,8 @@ pub struct Area {
     line: Option<Line>,
     /// A beam's cone (`divergence`), `None` for a light that fills its hemisphere.
     beam: Option<Beam>,
+    /// The polariser's transmission axis, if any ([`Area::polariser`]).
+    polariser: Option<Vec3>,
 }
 
 /// The cone of a beam of half-angle `θ`, kept as `sin² θ` and `tan θ` (computed in `f64` from the
@@ -160,6 +162,11 @@ impl Area {
         };
         let ok = area.is_finite() && area > 0.0 && light.center.is_finite() && frame.n.is_finite();
         let radiance = light.radiance.map(positive_or_zero);
+        // An ideal polariser passes half of the unpolarised light behind it.
+        let radiance = match light.polariser {
+            Some(_) => radiance * crate::polarisation::transport::ANALYSER_TRANSMITTANCE,
+            None => radiance,
+        };
         Area {
             center: light.center,
             frame,
@@ -170,7 +177,15 @@ impl Area {
             spectrum: light.spectrum.map(Measured::intern),
             line: light.line,
             beam: light.divergence.map(Beam::new),
+            polariser: light.polariser.and_then(|a| a.try_normalize()),
         }
+    }
+
+    /// The transmission axis of the polariser over the light (world, unit), if it has one: its
+    /// light is linearly polarised along it ([`crate::polarisation::transport`]).
+    #[inline]
+    pub fn polariser(&self) -> Option<Vec3> {
+        self.polariser
     }
 
     /// The light's measured emission spectrum, if the recipe gave one (its RGB colour is what
@@ -458,6 +473,7 @@ mod tests {
             spectrum: None,
             line: None,
             divergence: None,
+            polariser: None,
         })
     }
 

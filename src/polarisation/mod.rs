@@ -1,10 +1,10 @@
 //! Polarised light and crystal optics: Stokes vectors, Mueller matrices, the Fresnel matrices of
-//! dielectric and conductor interfaces, and refraction into a uniaxial crystal — the building
-//! blocks of a polarised spectral transport with birefringence. Nothing in the renderer uses them
-//! yet; they are tested against closed forms (Malus's law, Brewster's angle, the retardance of
-//! total internal reflection and Fresnel's rhomb, energy balance, the scalar Fresnel equations
-//! of [`crate::bsdf::fresnel`], Snell's law for the ordinary wave and the index ellipsoid's
-//! walk-off for the extraordinary one).
+//! dielectric and conductor interfaces, refraction into a uniaxial crystal, and the polarised
+//! transport the path loop runs when a scene calls for it ([`transport`]: the camera's Stokes
+//! row carried per channel). Tested against closed forms (Malus's law, Brewster's angle, the
+//! retardance of total internal reflection and Fresnel's rhomb, energy balance, the scalar
+//! Fresnel equations of [`crate::bsdf::fresnel`], Snell's law for the ordinary wave and the index
+//! ellipsoid's walk-off for the extraordinary one); renders in `tests/polarisation.rs`.
 //!
 //! # Conventions
 //!
@@ -25,6 +25,7 @@
 pub mod fresnel;
 pub mod interference;
 pub mod mueller;
+pub mod transport;
 pub mod uniaxial;
 
 pub use mueller::Mueller;

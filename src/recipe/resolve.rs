@@ -11,7 +11,7 @@ use super::stage::{
 use crate::color::Rgb;
 use crate::scene::stage::{
     AreaLight, Camera, Environment, Filter, Ground, LightShape, Projection, SamplerKind, Shape,
-    Stage, placement, rect_light,
+    Stage, light_axis, placement, rect_light,
 };
 use crate::scene::{Effect, Effects};
 use glam::Vec3;
@@ -27,8 +27,10 @@ pub(crate) fn stage(
     effects: &mut Effects,
     errors: &mut Vec<RecipeError>,
 ) -> Option<Stage> {
-    let mut stage = match r.content.stage.as_ref().and_then(|s| s.preset) {
+    let preset = r.content.stage.as_ref().and_then(|s| s.preset);
+    let mut stage = match preset {
         Some(super::stage::StagePreset::Jeweller) => Stage::jeweller(),
+        Some(super::stage::StagePreset::Polariscope { crossed, .. }) => Stage::polariscope(crossed),
         _ => Stage::studio(),
     };
     let n_errors = errors.len();
@@ -147,7 +149,7 @@ pub(crate) fn stage(
                 ));
                 continue;
             }
-            let (radiance, spectrum, line, divergence, two_sided) = match l {
+            let (radiance, spectrum, line, divergence, two_sided, polariser) = match l {
                 LightDesc::Rect {
                     radiance,
                     intensity,
@@ -155,6 +157,7 @@ pub(crate) fn stage(
                     line,
                     divergence,
                     two_sided,
+                    polariser,
                     ..
                 }
                 | LightDesc::Disc {
@@ -164,6 +167,7 @@ pub(crate) fn stage(
                     line,
                     divergence,
                     two_sided,
+                    polariser,
                     ..
                 } => (
                     colour(radiance) * *intensity,
@@ -171,8 +175,10 @@ pub(crate) fn stage(
                     line,
                     *divergence,
                     *two_sided,
+                    *polariser,
                 ),
             };
+            let polariser = polariser.map(|a| light_axis((target - center).normalize(), a));
             let light_error = |key: &str, m: &str| {
                 let at = lights_at.and_then(|l| src.nth_element(l, i)).or(lights_at);
                 let at = at.and_then(|a| src.find_from(a, &[key, ":"])).or(at);
@@ -240,6 +246,7 @@ pub(crate) fn stage(
                     spectrum,
                     line,
                     divergence,
+                    polariser,
                     ..rect_light(center, target, *size, radiance)
                 },
                 LightDesc::Disc {
@@ -253,6 +260,7 @@ pub(crate) fn stage(
                     spectrum,
                     line,
                     divergence,
+                    polariser,
                 },
             });
         }
@@ -339,6 +347,12 @@ pub(crate) fn stage(
             FilterDesc::Gaussian { radius } => Filter::Gaussian { radius },
         };
     }
+    if let Some(a) = desc.analyser {
+        stage.analyser = Some(a.to_radians());
+    }
+    if let Some(super::stage::StagePreset::Polariscope { rotation, .. }) = preset {
+        stage.to_world = glam::Affine3A::from_rotation_y(rotation.to_radians()) * stage.to_world;
+    }
     stage_effects(&stage, effects);
     (errors.len() == n_errors).then_some(stage)
 }
@@ -371,12 +385,22 @@ pub(crate) fn stage_effects(stage: &Stage, effects: &mut Effects) {
             format!("stage.environment Map(\"{}\")", path.display()),
         );
     }
+    // The analyser first: its reason is what tells the lane loop's check that one is there.
+    if let Some(a) = stage.analyser {
+        effects.turn_on(
+            Effect::Polarisation,
+            format!("stage.analyser = {:.1}°", a.to_degrees()),
+        );
+    }
     for (i, l) in stage.lights.iter().enumerate() {
         if l.spectrum.is_some() {
             effects.turn_on(Effect::Spectral, format!("stage.lights[{i}].spectrum"));
         }
         if l.line.is_some() {
             effects.turn_on(Effect::Spectral, format!("stage.lights[{i}].line"));
+        }
+        if l.polariser.is_some() {
+            effects.turn_on(Effect::Polarisation, format!("stage.lights[{i}].polariser"));
         }
     }
 }

@@ -213,6 +213,10 @@ pub struct StageDesc {
     /// Render settings, each overriding the studio's.
     #[serde(default)]
     pub render: RenderDesc,
+    /// An ideal linear polariser in front of the camera: its transmission axis in degrees from
+    /// the image's right toward its up, −360 ..= 360. Turns polarised transport on.
+    #[serde(default, deserialize_with = "axis_range")]
+    pub analyser: Option<f32>,
 }
 
 /// Object-to-world placement: scale, then rotations about x, y, z (degrees), then translation.
@@ -231,12 +235,36 @@ pub struct TransformDesc {
 }
 
 /// A built-in stage.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub enum StagePreset {
     /// Three soft boxes, a dim sky, a grey floor, a camera 30° down.
     Studio,
     /// A light tent: bright walls, two soft boxes, one small hard light, a macro camera.
     Jeweller,
+    /// The gemmologist's polariscope ([`crate::scene::Stage::polariscope`]): a dark room, a
+    /// polarised light box under the stone, an orthographic camera looking down through an
+    /// analyser. Turns polarised transport on.
+    Polariscope {
+        /// Analyser crossed with the polariser (default true; false: parallel).
+        #[serde(default = "yes")]
+        crossed: bool,
+        /// The stone turned about the vertical, degrees, −360 ..= 360 (default 0), after the
+        /// recipe's own `transform`.
+        #[serde(default, deserialize_with = "turn_range")]
+        rotation: f32,
+    },
+}
+
+fn yes() -> bool {
+    true
+}
+
+ranged!(turn_range, "rotation", -360.0, 360.0);
+ranged!(axis_value, "angle", -360.0, 360.0);
+
+/// A polariser's or analyser's axis, degrees, −360 ..= 360.
+fn axis_range<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f32>, D::Error> {
+    axis_value(d).map(Some)
 }
 
 /// How platelets are traced.
@@ -333,6 +361,12 @@ pub enum LightDesc {
         /// a beam (a laser's divergence). One-sided.
         #[serde(default, deserialize_with = "divergence_range")]
         divergence: Option<f32>,
+        /// An ideal linear polariser over the face: its transmission axis in degrees, −360 ..=
+        /// 360, from the light's horizontal in-plane direction (a rectangle's `size.0` edge)
+        /// toward the normal × that direction. It passes half the light, linearly polarised.
+        /// Turns polarised transport on.
+        #[serde(default, deserialize_with = "axis_range")]
+        polariser: Option<f32>,
     },
     /// A disc.
     Disc {
@@ -364,6 +398,12 @@ pub enum LightDesc {
         /// with a `line` and a `divergence`.
         #[serde(default, deserialize_with = "divergence_range")]
         divergence: Option<f32>,
+        /// An ideal linear polariser over the face: its transmission axis in degrees, −360 ..=
+        /// 360, from the light's horizontal in-plane direction (a rectangle's `size.0` edge)
+        /// toward the normal × that direction. It passes half the light, linearly polarised.
+        /// Turns polarised transport on.
+        #[serde(default, deserialize_with = "axis_range")]
+        polariser: Option<f32>,
     },
 }
 

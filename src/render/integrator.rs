@@ -66,14 +66,15 @@ use super::direct::{
 };
 use super::manifold;
 use super::manifold::{Chain, WalkNumbers, WalkVertex};
-use super::path::{ManifoldVertex, PathSample, PathState};
+use super::path::{ManifoldVertex, PathSample, PathState, keep_off_the_boundary};
+use super::polarised::polarise;
 use super::shading::shade;
 use super::world::{Hit, LightRef, World};
 use crate::bsdf::{Bsdf, Scatter};
 use crate::color::Rgb;
-use crate::geometry::ray::OFFSET_SCALE;
 use crate::geometry::{MediumId, Ray, offset_origin};
 use crate::medium::FreeFlight;
+use crate::polarisation::transport::{ANALYSER_TRANSMITTANCE, PathPolarisation};
 use crate::sampler::{PixelSampler, slots};
 use crate::spectrum::Spectral;
 use glam::Vec3;
@@ -119,6 +120,30 @@ where
 /// As [`trace`], and `lambda` – the wavelengths the path carries.
 pub fn trace_at<S: Spectral>(
     world: &World,
+    ray: Ray,
+    sampler: &mut PixelSampler,
+    max_depth: u32,
+    strategy: Strategy,
+    lambda: S::Wavelengths,
+) -> (PathSample, S)
+where
+    Bsdf: Scatter<S>,
+{
+    // Polarised transport is its own monomorphised loop, as the variants are: a scene without
+    // it runs code in which the Stokes row does not occur.
+    if world.polarised {
+        trace_path::<S, true>(world, ray, sampler, max_depth, strategy, lambda)
+    } else {
+        trace_path::<S, false>(world, ray, sampler, max_depth, strategy, lambda)
+    }
+}
+
+/// The path loop; with `POL` the path carries its sensor's Stokes row
+/// ([`crate::polarisation::transport`]): a camera analyser starts it, smooth dielectric
+/// boundaries act by Fresnel's Mueller matrices, every other vertex depolarises, and a polarised
+/// light's emission is measured by the row.
+fn trace_path<S: Spectral, const POL: bool>(
+    world: &World,
     mut ray: Ray,
     sampler: &mut PixelSampler,
     max_depth: u32,
@@ -136,6 +161,13 @@ where
         ray.medium = world.camera_medium;
     }
     let mut path = PathState::<S>::new(lambda, ray.medium);
+    let mut pol = PathPolarisation::UNPOLARISED;
+    if let Some(axis) = world.analyser {
+        if POL {
+            pol = PathPolarisation::analyser(axis, ray.dir);
+        }
+        path.beta *= ANALYSER_TRANSMITTANCE;
+    }
     loop {
         sampler.skip_to(slots::bounce(path.depth));
         out.rays += 1;
@@ -228,6 +260,9 @@ where
                         });
                     }
                     path.scatter_in_medium(ps.pdf, p);
+                    if POL {
+                        pol.depolarise();
+                    }
                     path.platelet = None;
                     if path.depth >= RR_DEPTH {
                         let q = path.survival();
@@ -251,8 +286,12 @@ where
                 break;
             }
             Some(Hit::Light { index, t }) => {
-                let le = world.areas[index]
+                let mut le = world.areas[index]
                     .emission::<S>(world.areas[index].emitted(-ray.dir), &path.lambda);
+                if POL && let Some(axis) = world.areas[index].polariser() {
+                    let k = pol.polarised_emission(axis, -ray.dir);
+                    le *= S::from_channels(|c| k[c]);
+                }
                 let w = match (path.manifold, &world.manifold) {
                     // The walk's chain of refractions since a vertex where the walk ran.
                     (Some(v), Some(setup)) if v.crossings == v.chain.crossings() => {
@@ -421,6 +460,9 @@ where
             S::terminate_secondary(&mut path.film);
         }
         path.scatter(&bs, sb.p, sb.inside);
+        if POL {
+            polarise(&mut pol, &mut path, &sb, &bs, wo, wo_local.z > 0.0);
+        }
         path.platelet = match hit {
             Hit::Platelet { id, .. } => Some(id),
             _ => None,
@@ -464,27 +506,4 @@ where
         out.radiance = path.l.to_rgb(&path.film);
     }
     (out, path.l)
-}
-
-/// A medium scattering point `p` on `ray`, moved off the surface hit the ray was heading for
-/// (`found`) to at least the spawn offset ([`OFFSET_SCALE`]) on the ray's side of its tangent
-/// plane. A point sampled within rounding of the boundary would start rays that miss it (the
-/// sphere's exit root rounds to ≤ 0) and leave the stone without crossing its surface, then
-/// scatter in the interior medium outside the stone until `medium-depth` ends them with nothing
-/// (tests/translucent/furnace.rs: one path in ~10⁴–10⁵ at σs 10–100 per unit). The move is
-/// below the offset every spawned surface ray gets.
-#[inline]
-fn keep_off_the_boundary(p: Vec3, ray: &Ray, found: Option<&Hit>) -> Vec3 {
-    let Some(Hit::Stone(h)) = found else {
-        return p;
-    };
-    let eps = OFFSET_SCALE * h.p.abs().max_element().max(1.0);
-    // The normal facing away from the ray's side, and p's distance below the tangent plane.
-    let n = if h.ng.dot(ray.dir) > 0.0 { h.ng } else { -h.ng };
-    let depth = (h.p - p).dot(n);
-    if depth < eps {
-        p - n * (eps - depth)
-    } else {
-        p
-    }
 }

@@ -26,6 +26,7 @@ pub mod memory;
 pub mod output;
 pub mod part;
 pub mod path;
+mod polarised;
 mod prefilter;
 pub mod setup;
 pub mod shading;

@@ -151,6 +151,7 @@ mod tests {
             spectrum: None,
             line: None,
             divergence: None,
+            polariser: None,
         }
     }
 

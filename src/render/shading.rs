@@ -113,6 +113,19 @@ impl<'a> SurfaceBsdf<'a> {
         )
     }
 
+    /// The relative IOR (below over above the frame's `z`) of a smooth dielectric interface at
+    /// the wavelength of `channel` ([`Scatter::interface_eta`]); `None` for any other model.
+    #[inline]
+    pub fn interface_eta<S: Spectral>(&self, channel: usize, lambda: &S::Wavelengths) -> Option<f32>
+    where
+        Bsdf: Scatter<S>,
+    {
+        if self.fluorescent.is_some() {
+            return None;
+        }
+        <Bsdf as Scatter<S>>::interface_eta(self.bxdf, channel, lambda)
+    }
+
     /// Density of `wi_local` (local frame) from `wo_local`.
     #[inline]
     pub fn pdf<S: Spectral>(&self, wo_local: Vec3, wi_local: Vec3, lambda: &S::Wavelengths) -> f32

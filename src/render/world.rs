@@ -125,6 +125,19 @@ pub struct World {
     pub lines: Vec<crate::spectrum::line::Line>,
     /// Centre and radius of a sphere bounding the stone, the floor patch under it and the lights.
     pub bounds: (Vec3, f32),
+    /// Polarised transport (the `polarisation` effect): paths carry their sensor's Stokes row
+    /// ([`crate::polarisation::transport`]); off, they carry intensity only.
+    pub polarised: bool,
+    /// The camera's analyser, an ideal linear polariser: its transmission axis (world, unit, in
+    /// the image plane). It passes half of unpolarised light, polarised transport or not.
+    pub analyser: Option<Vec3>,
+}
+
+/// The axis of the camera's analyser (world, unit) from its angle, radians from the image's right
+/// toward its up.
+fn analyser_axis(camera: &crate::scene::stage::Camera, angle: f32) -> Vec3 {
+    let (s, c) = angle.sin_cos();
+    (camera.right * c + camera.up * s).normalize()
 }
 
 impl World {
@@ -200,7 +213,18 @@ impl World {
         }
 
         let (light_prob, bounds) = lights::selection(&stone, &stage.lights, &areas, &environment);
-        let inside = inside::build(scene, &stone, &areas)?;
+        let mut inside = inside::build(scene, &stone, &areas)?;
+        // Polarised transport: the manifold walks carry a scalar through the boundary, which is
+        // exact only for a single crossing toward unpolarised light (module docs of
+        // `crate::polarisation::transport`); otherwise BSDF sampling alone finds those lights.
+        let polarised = scene.effects.on(Effect::Polarisation);
+        if polarised && let Some(m) = inside.manifold.as_mut() {
+            m.through = false;
+            m.inside &= areas.iter().all(|a| a.polariser().is_none());
+            if !m.inside {
+                inside.manifold = None;
+            }
+        }
 
         Ok(World {
             stone,
@@ -229,6 +253,8 @@ impl World {
             fluorescence: scene.effects.on(Effect::Fluorescence),
             lines: stage.lights.iter().filter_map(|l| l.line).collect(),
             bounds,
+            polarised,
+            analyser: stage.analyser.map(|a| analyser_axis(&stage.camera, a)),
         })
     }
 

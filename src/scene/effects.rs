@@ -43,11 +43,14 @@ pub enum Effect {
     /// Manifold next-event estimation from the floor through the stone (two refractions): the
     /// caustic a small light throws through a smooth body (Hanika et al. 2015).
     ManifoldCaustics,
+    /// Polarised transport ([`crate::polarisation::transport`]): each path carries its sensor's
+    /// Stokes row; smooth dielectric boundaries act by Fresnel's Mueller matrices.
+    Polarisation,
 }
 
 impl Effect {
     /// Every effect, in a fixed order.
-    pub const ALL: [Effect; 15] = [
+    pub const ALL: [Effect; 16] = [
         Effect::Absorption,
         Effect::TTerm,
         Effect::FacetBump,
@@ -63,6 +66,7 @@ impl Effect {
         Effect::LightPrefilter,
         Effect::DepthOfField,
         Effect::EnvironmentImportance,
+        Effect::Polarisation,
     ];
 
     /// Short name, as printed and as used by `--effect` toggles.
@@ -83,6 +87,7 @@ impl Effect {
             Effect::DepthOfField => "depth-of-field",
             Effect::EnvironmentImportance => "environment-importance",
             Effect::LightPrefilter => "light-prefilter",
+            Effect::Polarisation => "polarisation",
         }
     }
 
@@ -114,6 +119,10 @@ impl Effect {
             Effect::Fluorescence => "a used material whose Lambert base has `fluorescence`",
             Effect::DepthOfField => "a perspective camera with aperture > 0",
             Effect::EnvironmentImportance => "an environment Map (EXR)",
+            Effect::Polarisation => {
+                "a light with a `polariser`, a stage `analyser` (the `Polariscope` preset), or \
+                 `--polarised`"
+            }
             Effect::LightPrefilter => {
                 "an RGB render (`--spectral off`) of a stage whose lights have a `line` or a \
                  measured `spectrum`"

@@ -97,6 +97,10 @@ pub struct AreaLight {
     /// Half-angle of the cone about `normal` the light emits into, radians (a beam: a laser's
     /// divergence); `None` for the whole hemisphere. One-sided.
     pub divergence: Option<f32>,
+    /// An ideal linear polariser over the emitting face: its transmission axis (world, unit, in
+    /// the light's plane). It passes half of the light (`radiance` is the light's without it),
+    /// linearly polarised along the axis ([`crate::polarisation::transport`]).
+    pub polariser: Option<Vec3>,
 }
 
 /// The camera projection.
@@ -222,6 +226,9 @@ pub struct Stage {
     pub camera: Camera,
     /// Render settings.
     pub render: RenderSettings,
+    /// An ideal linear polariser in front of the camera (an analyser): its transmission axis in
+    /// radians from the image's right toward its up; `None` for none.
+    pub analyser: Option<f32>,
 }
 
 /// A rectangular soft box at `center` facing `target`, `w × h`, its `w` edge horizontal.
@@ -243,6 +250,7 @@ pub fn rect_light(center: Vec3, target: Vec3, size: (f32, f32), radiance: Rgb) -
         spectrum: None,
         line: None,
         divergence: None,
+        polariser: None,
     }
 }
 
@@ -309,6 +317,7 @@ impl Stage {
                     spectrum: None,
                     line: None,
                     divergence: None,
+                    polariser: None,
                 },
             ],
             camera,
@@ -382,8 +391,56 @@ impl Stage {
                 exposure: 0.0,
                 seed: 0,
             },
+            analyser: None,
         }
     }
+
+    /// The polariscope: a dark room, a light box under the stone whose polariser's axis is the
+    /// world `x` axis, and an orthographic camera looking straight down through an analyser,
+    /// crossed with the polariser (axis along `z`) or parallel to it. The stone rests on the box
+    /// (turned about the vertical by the recipe's preset, [`crate::recipe`]). A singly refractive
+    /// stone between crossed polars stays dark but where its facets reflect and refract at
+    /// oblique angles; a doubly refractive one blinks four times per turn.
+    pub fn polariscope(crossed: bool) -> Stage {
+        let camera = Camera::look_at(
+            Vec3::new(0.0, 6.0, 0.0),
+            Vec3::ZERO,
+            Vec3::NEG_Z,
+            Projection::Orthographic { height: 3.2 },
+        )
+        .expect("the polariscope's camera is well defined");
+        let mut light = rect_light(
+            Vec3::new(0.0, -0.05, 0.0),
+            Vec3::new(0.0, 1.0, 0.0),
+            (8.0, 8.0),
+            Rgb::splat(2.0),
+        );
+        light.polariser = Some(Vec3::X);
+        Stage {
+            ground: None,
+            environment: Environment::Constant(Rgb::ZERO),
+            lights: vec![light],
+            camera,
+            analyser: Some(if crossed {
+                std::f32::consts::FRAC_PI_2
+            } else {
+                0.0
+            }),
+            ..Stage::studio()
+        }
+    }
+}
+
+/// The world direction at `degrees` in the plane of a light facing `normal` (unit), measured
+/// from the edge [`rect_light`] makes horizontal (a rectangle's width edge) toward
+/// `normal × edge`: where a light's `polariser` axis points.
+pub fn light_axis(normal: Vec3, degrees: f32) -> Vec3 {
+    let side = normal
+        .cross(Vec3::Y)
+        .try_normalize()
+        .unwrap_or_else(|| normal.cross(Vec3::X).normalize());
+    let (s, c) = degrees.to_radians().sin_cos();
+    side * c + normal.cross(side) * s
 }
 
 #[cfg(test)]

@@ -196,6 +196,10 @@ impl Spectral for HeroSample {
     const CHANNELS: usize = N;
 
     #[inline]
+    fn from_channels(f: impl Fn(usize) -> f32) -> Self {
+        HeroSample(std::array::from_fn(f))
+    }
+    #[inline]
     fn splat(v: f32) -> Self {
         HeroSample([v; N])
     }

@@ -79,6 +79,8 @@ pub trait Spectral:
     const CHANNELS: usize;
     /// The same value in every channel.
     fn splat(v: f32) -> Self;
+    /// Channel `i` is `f(i)` (`i < CHANNELS`).
+    fn from_channels(f: impl Fn(usize) -> f32) -> Self;
     /// The wavelengths of a camera path from the sampler's wavelength slot `u ∈ [0, 1)`
     /// ([`crate::sampler`] layout).
     fn sample_wavelengths(u: f32) -> Self::Wavelengths;

@@ -116,6 +116,10 @@ impl Spectral for RgbSample {
         RgbSample::map(self, f)
     }
     #[inline]
+    fn from_channels(f: impl Fn(usize) -> f32) -> Self {
+        RgbSample(std::array::from_fn(f))
+    }
+    #[inline]
     fn splat(v: f32) -> Self {
         RgbSample::splat(v)
     }

@@ -180,3 +180,45 @@ fn light_prefilter_runs_only_for_rgb_renders_under_spectral_lights() {
     );
     assert_live(Effect::LightPrefilter, "the RGB day-glo laser scene", &rgb);
 }
+
+#[test]
+fn polarisation_code_changes_nothing_without_a_smooth_boundary_or_polariser() {
+    // Polarised transport forced on: every vertex of these scenes depolarises (Lambert, layered
+    // stacks, metals, a rough body boundary and its scattering medium), so the Stokes row stays
+    // zero and every throughput correction is exactly 1.
+    let rough_body = scene(
+        r#"(materials: {
+               "body": (coats: [(ior: 1.5, roughness: 2.0, thickness: 1.0, tint: Rgb(0.9, 0.6, 0.8))],
+                        base: Lambert(albedo: Gray(0.6))),
+               "glitter": (base: Conductor(metal: Silver, roughness: 2.0)) },
+            body: (ior: 1.55, roughness: 3.0,
+                   medium: (colour: Srgb(0.9, 0.7, 0.6), distance: 1.0, scattering: (2.0, 2.0, 2.0))),
+            surface: Overlay(
+                under: Switch(by: Marble(scale: 0.5), stops: [(0.0, Material("body")), (0.4, Body)]),
+                over: Voronoi(scale: 0.06, fill: 0.1, entries: [(1.0, Material("glitter"))])))"#,
+    );
+    assert!(!rough_body.effects.called(Effect::Polarisation));
+    assert_untouched(
+        Effect::Polarisation,
+        "a rough translucent body under layered materials",
+        &rough_body,
+    );
+    assert_untouched(
+        Effect::Polarisation,
+        "the opaque Sunstone",
+        &gem("sunstone.ron"),
+    );
+    // Live: a smooth glass sphere between crossed polars shows only where its boundary turns
+    // the light's polarisation (the dark Maltese cross); forced off, the analyser passes half of
+    // every path's light instead.
+    let crossed = scene(
+        r#"(materials: {}, body: (ior: 1.5), surface: Body,
+            stage: (preset: Polariscope(crossed: true), shape: Sphere(radius: 0.8),
+                    transform: (translate: (0.0, 0.802, 0.0))))"#,
+    );
+    assert_live(
+        Effect::Polarisation,
+        "a glass sphere in the polariscope",
+        &crossed,
+    );
+}

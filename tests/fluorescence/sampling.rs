@@ -236,6 +236,7 @@ fn beam(radius: f32) -> Area {
         spectrum: None,
         line: None,
         divergence: Some(0.3f32.to_radians()),
+        polariser: None,
     })
 }
 

@@ -36,6 +36,10 @@ pub fn unsupported(world: &World) -> Option<&'static str> {
         Some("manifold next-event estimation")
     } else if world.fluorescence {
         Some("fluorescence")
+    } else if world.polarised {
+        Some("polarised transport")
+    } else if world.analyser.is_some() {
+        Some("a camera analyser")
     } else {
         None
     }
@@ -54,10 +58,18 @@ pub fn scalar_because(effects: &crate::scene::Effects) -> Option<&'static str> {
         (Effect::ManifoldNee, "manifold next-event estimation"),
         (Effect::ManifoldCaustics, "manifold next-event estimation"),
         (Effect::Fluorescence, "fluorescence"),
+        (Effect::Polarisation, "polarised transport"),
     ]
     .into_iter()
     .find(|(e, _)| effects.on(*e))
     .map(|(_, why)| why)
+    .or_else(|| {
+        // The analyser still halves the light with polarisation forced off.
+        effects
+            .reason(Effect::Polarisation)
+            .is_some_and(|(r, _)| r.contains("analyser"))
+            .then_some("a camera analyser")
+    })
 }
 
 /// Traces `packet` with the kernel compiled for the widest instruction set this machine has
