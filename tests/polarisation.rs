@@ -158,3 +158,223 @@ fn white_furnace_stays_white_and_unpolarised() {
         }
     }
 }
+
+/// A calcite slab (n_o 1.6584, n_e 1.4864; Hecht, *Optics*, table 8.1) 3 units thick, its optic
+/// axis at 45° to the faces, over a small lamp, seen straight down through an analyser along
+/// `analyser` degrees (`None`: none).
+fn calcite(analyser: Option<f32>) -> Scene {
+    let a = analyser.map_or(String::new(), |a| format!("analyser: {a},"));
+    compile(&format!(
+        r#"(materials: {{}}, surface: Body,
+            body: (ior: 1.6584, crystal: Uniaxial(ne: 1.4864, axis: (1.0, 1.0, 0.0))),
+            stage: (shape: Slab(size: (4.0, 3.0, 4.0)), ground: Off,
+                    environment: Constant(Gray(0.0)),
+                    lights: [Disc(center: (0.0, -2.0, 0.0), target: (0.0, 0.0, 0.0),
+                                  radius: 0.05, radiance: Gray(10.0))],
+                    camera: Orthographic(from: (0.0, 5.0, 0.0), to: (0.0, 0.0, 0.0),
+                                         up: (0.0, 0.0, -1.0), height: 1.2),
+                    {a}
+                    render: (width: 128, height: 128, spp: 16, max_depth: 16)))"#
+    ))
+}
+
+/// Total luminance and its centroid along world x (the image's right) over pixels with
+/// `x` in `range`.
+fn spot(scene: &Scene, range: std::ops::Range<f64>) -> (f64, f64) {
+    let world = World::new(scene).expect("world");
+    let r = render_scene(&world, scene, &Control::default());
+    let (w, h) = (scene.stage.render.width, scene.stage.render.height);
+    let rgb = r.film.rgb();
+    let (mut sum, mut sx) = (0.0, 0.0);
+    for y in 0..h {
+        for x in 0..w {
+            let wx = (f64::from(x) + 0.5) / f64::from(w) * 1.2 - 0.6;
+            if range.contains(&wx) {
+                let v = f64::from(rgb[(y * w + x) as usize][1]);
+                sum += v;
+                sx += v * wx;
+            }
+        }
+    }
+    (sum, if sum > 0.0 { sx / sum } else { f64::NAN })
+}
+
+/// The calcite rhomb's double image: the ordinary ray goes straight through, the extraordinary
+/// one walks off by `ρ`, `tan ρ = ½ n(θ)² (1/n_e² − 1/n_o²) sin 2θ` (Yariv & Yeh eq. 4.3-14,
+/// written here independently of the renderer), so the lamp shows twice, `d tan ρ` apart; an
+/// analyser across the axis's plane keeps only the ordinary image, one along it only the
+/// extraordinary — the two images are polarised at right angles. Centroids within a pixel.
+#[test]
+fn calcite_doubles_and_polarises_the_image() {
+    let (no, ne) = (1.6584f64, 1.4864f64);
+    let theta = std::f64::consts::FRAC_PI_4;
+    let n2 = 1.0 / (theta.cos().powi(2) / (no * no) + theta.sin().powi(2) / (ne * ne));
+    let tan_rho = 0.5 * n2 * (1.0 / (ne * ne) - 1.0 / (no * no)) * (2.0 * theta).sin();
+    let shift = 3.0 * tan_rho.abs();
+    let pixel = 1.2 / 128.0;
+    let s = calcite(None);
+    assert!(s.effects.on(Effect::Polarisation));
+    let (o, xo) = spot(&s, -0.15..0.15);
+    let (e_left, xl) = spot(&s, -0.6..-0.15);
+    let (e_right, xr) = spot(&s, 0.15..0.6);
+    let (e, xe) = if e_left > e_right {
+        (e_left, xl)
+    } else {
+        (e_right, xr)
+    };
+    eprintln!("o image at {xo:.4} ({o:.1}), e image at {xe:.4} ({e:.1}); d tan ρ = {shift:.4}");
+    assert!(xo.abs() < pixel, "ordinary image at {xo}");
+    assert!(
+        (xe.abs() - shift).abs() < pixel,
+        "extraordinary image at {xe}, want ±{shift}"
+    );
+    assert!(
+        e_left.min(e_right) < 1e-3 * e,
+        "one extraordinary image only"
+    );
+    // Each image carries about half the light (their transmittances differ by a few %).
+    assert!((o / e - 1.0).abs() < 0.15, "o/e {}", o / e);
+    // The axis lies in the x–y plane: the extraordinary field along x, the ordinary along z.
+    for (a, keeps_o) in [(0.0, false), (90.0, true)] {
+        let s = calcite(Some(a));
+        let (o2, _) = spot(&s, -0.15..0.15);
+        let (e2, _) = spot(&s, -0.6..-0.15);
+        let (e3, _) = spot(&s, 0.15..0.6);
+        let e2 = e2 + e3;
+        eprintln!("analyser {a}°: o {o2:.2}, e {e2:.2}");
+        let (kept, gone) = if keeps_o { (o2, e2) } else { (e2, o2) };
+        assert!(gone < 1e-3 * kept, "analyser {a}°: {o2} {e2}");
+    }
+}
+
+/// A lossless calcite sphere in a white unpolarised furnace reads 1 (equilibrium), within its
+/// noise and the radiance-scaling approximation across the boundary (`crystal.rs`: the
+/// walk-off's share of the invariant is left out), which this bounds at 1 %.
+#[test]
+fn calcite_sphere_in_a_white_furnace() {
+    for axis in ["(0.0, 1.0, 0.0)", "(1.0, 1.0, 0.3)"] {
+        let s = compile(&format!(
+            r#"(materials: {{}}, surface: Body,
+                body: (ior: 1.6584, crystal: Uniaxial(ne: 1.4864, axis: {axis})),
+                stage: (shape: Sphere(radius: 1.0), ground: Off,
+                        environment: Constant(Gray(1.0)), lights: [],
+                        camera: Orthographic(from: (0.0, 0.0, 5.0), to: (0.0, 0.0, 0.0), height: 2.0),
+                        render: (width: 32, height: 32, spp: 64, max_depth: 64)))"#
+        ));
+        let (got, se) = mean(&s);
+        eprintln!("calcite sphere, axis {axis}: {got:.5} ± {se:.5}");
+        assert!(
+            (got - 1.0).abs() < 0.01 + 5.0 * se,
+            "axis {axis}: {got} ± {se}"
+        );
+    }
+}
+
+/// A plate cut parallel to its optic axis between the polariscope's crossed polars, turned by
+/// `rotation` degrees (quartz, n_o 1.544, n_e 1.553; or glass with `crystal: false`).
+fn plate(rotation: f64, crystal: bool) -> Scene {
+    let optics = if crystal {
+        "ior: 1.544, crystal: Uniaxial(ne: 1.553, axis: (1.0, 0.0, 0.0))"
+    } else {
+        "ior: 1.544"
+    };
+    compile(&format!(
+        r#"(materials: {{}}, surface: Body, body: ({optics}),
+            stage: (preset: Polariscope(crossed: true, rotation: {rotation}),
+                    shape: Slab(size: (2.0, 0.5, 2.0)), transform: (translate: (0.0, 0.3, 0.0)),
+                    render: (width: 40, height: 40, spp: 16, max_depth: 16, seed: 5)))"#
+    ))
+}
+
+/// Between crossed polars a doubly refractive plate blinks four times per turn: seen straight
+/// through, the light splits into the two waves along and across the axis and the analyser
+/// passes `¼ sin² 2φ (T_e² + T_o²)` of it (incoherent sum, "high-order white"), so relative to
+/// 45° the image follows `sin² 2φ`; a glass plate stays black at every angle.
+#[test]
+fn a_doubly_refractive_plate_blinks_and_glass_stays_dark() {
+    let (bright, se45) = mean(&plate(45.0, true));
+    assert!(bright > 0.05, "{bright}");
+    for phi in [0.0f64, 15.0, 30.0, 60.0, 90.0, 135.0] {
+        let (got, se) = mean(&plate(phi, true));
+        let want = bright * (2.0 * phi.to_radians()).sin().powi(2);
+        let tol = 5.0 * (se * se + (se45 * want / bright).powi(2)).sqrt() + 1e-6;
+        eprintln!("φ {phi}°: {got:.5} ± {se:.5} (sin² 2φ × the 45° image: {want:.5})");
+        assert!(
+            (got - want).abs() <= tol,
+            "φ {phi}°: {got} vs {want} ± {tol}"
+        );
+        let (glass, _) = mean(&plate(phi, false));
+        assert!(glass < 1e-6, "glass at {phi}°: {glass}");
+    }
+}
+
+/// A dichroic plate (index 1.62 for both waves, so only the absorption differs) 0.5 thick, its
+/// axis along x in its faces, on a white light box, seen straight down through an analyser.
+fn dichroic(analyser: Option<f32>) -> Scene {
+    let a = analyser.map_or(String::new(), |a| format!("analyser: {a},"));
+    compile(&format!(
+        r#"(materials: {{}}, surface: Body,
+            body: (ior: 1.62, crystal: Uniaxial(ne: 1.62, axis: (1.0, 0.0, 0.0),
+                   pleochroism: (ordinary: Gray(0.2), extraordinary: Gray(0.8), distance: 0.5))),
+            stage: (shape: Slab(size: (3.0, 0.5, 3.0)), ground: Off,
+                    environment: Constant(Gray(0.0)),
+                    lights: [Rect(center: (0.0, -1.0, 0.0), target: (0.0, 0.0, 0.0),
+                                  size: (20.0, 20.0), radiance: Gray(1.0))],
+                    camera: Orthographic(from: (0.0, 5.0, 0.0), to: (0.0, 0.0, 0.0),
+                                         up: (0.0, 0.0, -1.0), height: 1.0),
+                    {a}
+                    render: (width: 24, height: 24, spp: 16, max_depth: 16)))"#
+    ))
+}
+
+/// Pleochroism: through an analyser along the axis the plate shows the extraordinary wave's
+/// colour, across it the ordinary's; light crossing the plate once keeps `τ T²` (`τ` the wave's
+/// colour after the thickness, `T = 1 − ((n − 1)/(n + 1))²` per face), half of it passing the
+/// analyser; internal reflections add `τ³ R² T²`, under 0.3 % here.
+#[test]
+fn a_dichroic_plate_shows_each_waves_colour() {
+    let r = ((1.62f64 - 1.0) / 2.62).powi(2);
+    let t2 = (1.0 - r).powi(2);
+    for (analyser, tau) in [(0.0f32, 0.8f64), (90.0, 0.2)] {
+        let (got, se) = mean(&dichroic(Some(analyser)));
+        let want = 0.5 * t2 * (tau + tau.powi(3) * r * r);
+        eprintln!("analyser {analyser}°: {got:.5} ± {se:.5} (closed form {want:.5})");
+        assert!(
+            (got - want).abs() < 1e-3 * want + 5.0 * se,
+            "{analyser}°: {got} vs {want}"
+        );
+    }
+    // Without an analyser, the mean of the two.
+    let (got, se) = mean(&dichroic(None));
+    let want = 0.5 * t2 * (0.8 + 0.2 + (0.8f64.powi(3) + 0.2f64.powi(3)) * r * r);
+    eprintln!("no analyser: {got:.5} ± {se:.5} (closed form {want:.5})");
+    assert!(
+        (got - want).abs() < 1e-3 * want + 5.0 * se,
+        "{got} vs {want}"
+    );
+}
+
+/// Polarised renders with crystals are deterministic: the pleochroic sunstone renders
+/// bit-identically on 1 and 2 threads.
+#[test]
+fn polarised_crystal_renders_are_thread_count_independent() {
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("gems/oregon-sunstone-dichroic.ron");
+    let mut s = GemRecipe::load(&path).and_then(|r| r.compile()).unwrap();
+    s.stage.render.width = 32;
+    s.stage.render.height = 24;
+    s.stage.render.spp = 8;
+    let world = World::new(&s).unwrap();
+    let films: Vec<Vec<[f32; 3]>> = [1, 2]
+        .map(|t| {
+            let c = Control {
+                threads: Some(t),
+                ..Control::default()
+            };
+            render_scene(&world, &s, &c).film.rgb()
+        })
+        .into();
+    let bits = |f: &Vec<[f32; 3]>| f.iter().flatten().map(|v| v.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&films[0]), bits(&films[1]));
+    assert!(films[0].iter().flatten().any(|v| *v > 0.0));
+}

@@ -207,6 +207,14 @@ fn rows() -> Vec<Row> {
         // A Sellmeier law below its resonance (C₁ = 0.25 µm²: 500 nm) gives n² < 1: the law's own
         // n², not the index 1 it is clamped to.
         row("sellmeier_n2_below_one", (3, 3), &["body.dispersion", "n² = 0.4618 < 1 (n = 0.6796) at 360 nm", "allowed 1 <.. 4"], gem(" body: (ior: 1.6771,\n  dispersion: Sellmeier(b: (0.5, 0.0, 0.0), c: (0.25, 0.0, 0.0))),\n surface: Body")),
+        // --- Crystal optics (issue 40).
+        row("crystal_rough", (3, 3), &["body.crystal", "needs a smooth boundary"], gem(" body: (ior: 1.544, roughness: 2.0,\n  crystal: Uniaxial(ne: 1.553, axis: (0.0, 1.0, 0.0))),\n surface: Body")),
+        row("crystal_ne_five", (3, 25), &["crystal.ne = 5", "1.0001 ..= 4"], gem(" body: (ior: 1.544,\n  crystal: Uniaxial(ne: 5.0, axis: (0.0, 1.0, 0.0))),\n surface: Body")),
+        row("crystal_axis_zero", (3, 38), &["axis = (0.0, 0.0, 0.0)", "non-zero direction"], gem(" body: (ior: 1.544,\n  crystal: Uniaxial(ne: 1.553, axis: (0.0, 0.0, 0.0))),\n surface: Body")),
+        row("pleochroism_black", (4, 4), &["body.crystal.pleochroism.ordinary", "0 <..= 1"], gem(" body: (ior: 1.544,\n  crystal: Uniaxial(ne: 1.553, axis: (0.0, 1.0, 0.0),\n   pleochroism: (ordinary: Gray(0.0), extraordinary: Gray(0.5), distance: 1.0))),\n surface: Body")),
+        row("analyser_400", (4, 13), &["analyser = 400", "-360 ..= 360"], stage("  analyser: 400.0,")),
+        row("polariscope_rotation_500", (4, 33), &["rotation = 500", "-360 ..= 360"], stage("  preset: Polariscope(rotation: 500.0),")),
+        row("polariser_minus_400", (4, 92), &["polariser = -400", "-360 ..= 360"], stage("  lights: [Rect(center: (0.0, 4.0, 0.0), size: (1.0, 1.0), radiance: Gray(1.0), polariser: -400.0)],")),
         row("light_target_is_center", (6, 4), &["stage.lights[1]", "`target` equals `center`"], stage("  lights: [\n   Rect(center: (0.0, 4.0, 0.0), size: (1.0, 1.0), radiance: Gray(1.0)),\n   Disc(center: (1.0, 2.0, 3.0), target: (1.0, 2.0, 3.0), radius: 1.0, radiance: Gray(1.0)),\n  ],")),
     ];
     rows

@@ -22,6 +22,8 @@
 //! - Jones amplitudes use the time dependence `e^{−iωt}` (Born & Wolf); `S3 > 0` is then the
 //!   polarisation whose `y` component lags.
 
+pub mod boundary;
+pub mod crystal;
 pub mod fresnel;
 pub mod interference;
 pub mod mueller;

@@ -83,6 +83,46 @@ impl Mueller {
             .then_after(&Mueller::rotator(axis))
     }
 
+    /// The Mueller matrix of a general Jones matrix `j` (`j[out][in]`, amplitudes along `x` and
+    /// `y`), column by column: each basis Stokes vector as a coherency matrix
+    /// `C = [[S0 + S1, S2 − i S3], [S2 + i S3, S0 − S1]] / 2` (the sign of `S3` of
+    /// [`super`]'s convention), carried to `J C J†` and read back (Collett 2005, §4.4).
+    pub fn from_jones(j: [[Complex64; 2]; 2]) -> Mueller {
+        let i = Complex64::i();
+        let mut m = [[0.0; 4]; 4];
+        for col in 0..4 {
+            let mut s = [0.0; 4];
+            s[col] = 1.0;
+            let c = [
+                [
+                    Complex64::from(0.5 * (s[0] + s[1])),
+                    (s[2] - i * s[3]) * 0.5,
+                ],
+                [
+                    (s[2] + i * s[3]) * 0.5,
+                    Complex64::from(0.5 * (s[0] - s[1])),
+                ],
+            ];
+            // J C J†.
+            let jc: [[Complex64; 2]; 2] = std::array::from_fn(|r| {
+                std::array::from_fn(|k| j[r][0] * c[0][k] + j[r][1] * c[1][k])
+            });
+            let out: [[Complex64; 2]; 2] = std::array::from_fn(|r| {
+                std::array::from_fn(|k| jc[r][0] * j[k][0].conj() + jc[r][1] * j[k][1].conj())
+            });
+            let col_s = [
+                (out[0][0] + out[1][1]).re,
+                (out[0][0] - out[1][1]).re,
+                2.0 * out[0][1].re,
+                -2.0 * out[0][1].im,
+            ];
+            for r in 0..4 {
+                m[r][col] = col_s[r];
+            }
+        }
+        Mueller(m)
+    }
+
     /// The Mueller matrix of the diagonal Jones matrix `diag(jx, jy)` (amplitudes along `x` and
     /// `y`): Collett 2005, eq. 4.38. `C = Re(jx jy*)` couples `S2, S3` as a retarder of phase
     /// `arg(jx jy*)`; `A ± B` are the intensity transmittances along `x` and `y`.
@@ -103,6 +143,39 @@ impl Mueller {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The general conversion agrees with the diagonal formula, and a rotated polariser's Jones
+    /// matrix gives the rotated polariser's Mueller matrix.
+    #[test]
+    fn general_jones_agrees_with_the_closed_forms() {
+        let (a, b) = (
+            Complex64::from_polar(0.8, 0.3),
+            Complex64::from_polar(0.5, -1.1),
+        );
+        let z = Complex64::from(0.0);
+        let g = Mueller::from_jones([[a, z], [z, b]]);
+        let d = Mueller::diagonal_jones(a, b);
+        for r in 0..4 {
+            for c in 0..4 {
+                assert!((g.0[r][c] - d.0[r][c]).abs() < 1e-12, "{g:?} {d:?}");
+            }
+        }
+        let t = 0.37f64;
+        let (s, c) = t.sin_cos();
+        let pol = Mueller::from_jones([
+            [Complex64::from(c * c), Complex64::from(c * s)],
+            [Complex64::from(c * s), Complex64::from(s * s)],
+        ]);
+        let want = Mueller::linear_polariser(t);
+        for r in 0..4 {
+            for k in 0..4 {
+                assert!(
+                    (pol.0[r][k] - want.0[r][k]).abs() < 1e-12,
+                    "{pol:?} {want:?}"
+                );
+            }
+        }
+    }
     use std::f64::consts::{FRAC_PI_2, PI};
 
     /// Malus's law: unpolarised light through two polarisers at `θ` to each other keeps

@@ -39,6 +39,10 @@ pub struct PathPolarisation {
     pub x: Vec3,
     /// Per channel, `(w₁, w₂, w₃) / w₀` of the sensor's row in frame `x`.
     pub w: [[f32; 3]; MAX_CHANNELS],
+    /// Inside a doubly refractive crystal, the wave the segment's light travels in (its row is
+    /// then that wave's pure polarisation, [`super::crystal`]); `None` elsewhere, and inside
+    /// after a depolarising vertex.
+    pub mode: Option<super::boundary::Mode>,
 }
 
 /// An interface event's kind.
@@ -55,6 +59,7 @@ impl PathPolarisation {
     pub const UNPOLARISED: PathPolarisation = PathPolarisation {
         x: Vec3::X,
         w: [[0.0; 3]; MAX_CHANNELS],
+        mode: None,
     };
 
     /// The row of a camera behind an ideal linear analyser whose transmission axis is `axis`
@@ -68,6 +73,7 @@ impl PathPolarisation {
             Some(x) => PathPolarisation {
                 x,
                 w: [[1.0, 0.0, 0.0]; MAX_CHANNELS],
+                mode: None,
             },
             None => PathPolarisation::UNPOLARISED,
         }
@@ -83,6 +89,7 @@ impl PathPolarisation {
     #[inline]
     pub fn depolarise(&mut self) {
         self.w = [[0.0; 3]; MAX_CHANNELS];
+        self.mode = None;
     }
 
     /// Re-expresses the row in the frame with axis `x_new` (unit, orthogonal to the light's
@@ -209,6 +216,7 @@ mod tests {
         let mut p = PathPolarisation {
             x: x0,
             w: [[0.6, -0.3, 0.5]; MAX_CHANNELS],
+            mode: None,
         };
         let s = Stokes([1.0, 0.2, -0.7, 0.4]);
         let before = measure(&p, s);

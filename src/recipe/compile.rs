@@ -9,6 +9,7 @@ use super::gem::GemRecipe;
 use super::map_compiler::{BODY_LEAF, Compiler};
 use super::source::Source;
 use crate::bsdf::StackDesc;
+use crate::color::Rgb;
 use crate::sampler::hash_words;
 use crate::scene::{Accuracy, Body, Effect, Interior, Scene, Surface, accuracy};
 use crate::texture::{Map, MapNode};
@@ -327,6 +328,34 @@ impl Compiler<'_> {
             },
         };
         let (platelets, platelet_materials) = self.platelets(desc, body_index, at.unwrap_or(0))?;
+        let crystal = match &desc.crystal {
+            None => None,
+            Some(super::body::CrystalDesc::Uniaxial {
+                ne,
+                axis,
+                pleochroism,
+            }) => {
+                let (sigma_o, sigma_e) = match pleochroism.as_ref().map(|p| p.coefficients()) {
+                    None => (Rgb::ZERO, Rgb::ZERO),
+                    Some(Ok(s)) => s,
+                    Some(Err(m)) => {
+                        let at = r
+                            .source
+                            .find_from(at.unwrap_or(0), &["pleochroism", ":"])
+                            .or(at);
+                        self.errors
+                            .push(r.source.error(at, format!("body.crystal.{m}")));
+                        return None;
+                    }
+                };
+                Some(crate::scene::body::Crystal {
+                    ne: *ne,
+                    axis: glam::Vec3::new(axis.0, axis.1, axis.2).normalize(),
+                    sigma_o,
+                    sigma_e,
+                })
+            }
+        };
         let body = Body {
             ior: desc.ior,
             dispersion,
@@ -337,9 +366,33 @@ impl Compiler<'_> {
             medium,
             platelets,
             platelet_materials,
+            crystal,
         };
+        if body.crystal.is_some() && alpha > 0.0 {
+            let at = r
+                .source
+                .find_from(at.unwrap_or(0), &["crystal", ":"])
+                .or(at);
+            self.errors.push(r.source.error(
+                at,
+                "body.crystal: a doubly refractive body needs a smooth boundary (remove \
+                 `roughness`/`alpha`)",
+            ));
+            return None;
+        }
         if shown {
             self.effects.turn_on(Effect::Transmission, place.clone());
+            if body.crystal.is_some() {
+                let c = r
+                    .source
+                    .find_from(at.unwrap_or(0), &["crystal", ":"])
+                    .or(at);
+                let e = r.source.error(c, "");
+                self.effects.turn_on(
+                    Effect::Polarisation,
+                    format!("body.crystal ({}:{})", e.file, e.line),
+                );
+            }
             if body.dispersion.is_some() {
                 let d = r
                     .source
@@ -410,8 +463,10 @@ impl Compiler<'_> {
     /// that scatter light), through the stone (`manifold-caustics`) where a floor receives its
     /// caustic. Not for a dispersive body: the walks solve Snell's law with one index, and a
     /// spectral path refracts each wavelength its own way (there light is found by BSDF sampling).
+    /// Nor for a doubly refractive body, whose boundary splits light into two waves the walk
+    /// does not follow.
     fn manifold_effect(&mut self, body: &Body, stage: &crate::scene::stage::Stage) {
-        if body.dispersion.is_some() {
+        if body.dispersion.is_some() || body.crystal.is_some() {
             return;
         }
         let r = self.recipe;

@@ -215,7 +215,7 @@ pub struct StageDesc {
     pub render: RenderDesc,
     /// An ideal linear polariser in front of the camera: its transmission axis in degrees from
     /// the image's right toward its up, −360 ..= 360. Turns polarised transport on.
-    #[serde(default, deserialize_with = "axis_range")]
+    #[serde(default, deserialize_with = "analyser_range")]
     pub analyser: Option<f32>,
 }
 
@@ -260,11 +260,17 @@ fn yes() -> bool {
 }
 
 ranged!(turn_range, "rotation", -360.0, 360.0);
-ranged!(axis_value, "angle", -360.0, 360.0);
+ranged!(analyser_value, "analyser", -360.0, 360.0);
+ranged!(polariser_value, "polariser", -360.0, 360.0);
 
-/// A polariser's or analyser's axis, degrees, −360 ..= 360.
-fn axis_range<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f32>, D::Error> {
-    axis_value(d).map(Some)
+/// An analyser's axis, degrees, −360 ..= 360.
+fn analyser_range<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f32>, D::Error> {
+    analyser_value(d).map(Some)
+}
+
+/// A light's polariser axis, degrees, −360 ..= 360.
+fn polariser_range<'de, D: Deserializer<'de>>(d: D) -> Result<Option<f32>, D::Error> {
+    polariser_value(d).map(Some)
 }
 
 /// How platelets are traced.
@@ -365,7 +371,7 @@ pub enum LightDesc {
         /// 360, from the light's horizontal in-plane direction (a rectangle's `size.0` edge)
         /// toward the normal × that direction. It passes half the light, linearly polarised.
         /// Turns polarised transport on.
-        #[serde(default, deserialize_with = "axis_range")]
+        #[serde(default, deserialize_with = "polariser_range")]
         polariser: Option<f32>,
     },
     /// A disc.
@@ -402,7 +408,7 @@ pub enum LightDesc {
         /// 360, from the light's horizontal in-plane direction (a rectangle's `size.0` edge)
         /// toward the normal × that direction. It passes half the light, linearly polarised.
         /// Turns polarised transport on.
-        #[serde(default, deserialize_with = "axis_range")]
+        #[serde(default, deserialize_with = "polariser_range")]
         polariser: Option<f32>,
     },
 }

@@ -67,7 +67,9 @@ use super::direct::{
 use super::manifold;
 use super::manifold::{Chain, WalkNumbers, WalkVertex};
 use super::path::{ManifoldVertex, PathSample, PathState, keep_off_the_boundary};
-use super::polarised::polarise;
+use super::polarised::{
+    crystal_boundary, crystal_sample, pleochroic_segment, pleochroic_transmittance, polarise,
+};
 use super::shading::shade;
 use super::world::{Hit, LightRef, World};
 use crate::bsdf::{Bsdf, Scatter};
@@ -202,6 +204,10 @@ where
                 });
             }
         }
+        // A pleochroic crystal absorbs by the wave the segment carries (polarised transport).
+        let pleochroic = POL
+            .then(|| pleochroic_segment(world, path.medium, sampler))
+            .flatten();
         if world.medium {
             let medium = &world.media[usize::from(path.medium.0)];
             let t_hit = found.as_ref().map_or(f32::INFINITY, Hit::t);
@@ -213,6 +219,10 @@ where
                 FreeFlight::Pass { value, pdf } => path.take_flight(hero, value, pdf),
                 FreeFlight::Scatter { t, value, pdf } => {
                     path.take_flight(hero, value, pdf);
+                    if let Some((c, u)) = pleochroic {
+                        path.beta *=
+                            pleochroic_transmittance::<S>(c, &mut pol, ray.dir, t, u, &path.lambda);
+                    }
                     if path.medium_events >= world.medium_depth || !path.alive() {
                         break;
                     }
@@ -275,6 +285,12 @@ where
                     continue;
                 }
             }
+        }
+        if let Some((c, u)) = pleochroic
+            && let Some(h) = &found
+        {
+            path.beta *=
+                pleochroic_transmittance::<S>(c, &mut pol, ray.dir, h.t(), u, &path.lambda);
         }
         let hit = match found {
             None => {
@@ -422,7 +438,18 @@ where
         // Continue the path by sampling the BSDF.
         let uc = sampler.get1d();
         let u = sampler.get2d();
-        let Some(bs) = sb.sample::<S>(wo_local, uc, u, &path.lambda) else {
+        // A doubly refractive body's boundary (polarised transport only): its own sampling.
+        let crystal = POL
+            .then(|| crystal_boundary::<S>(world, &hit, &sb, &path.lambda))
+            .flatten();
+        let sampled = match crystal {
+            Some(c) => {
+                let outside = path.medium == MediumId::OUTSIDE;
+                crystal_sample::<S>(c, &mut pol, &sb, wo, outside, &path.lambda, (uc, u.x))
+            }
+            None => sb.sample::<S>(wo_local, uc, u, &path.lambda),
+        };
+        let Some(bs) = sampled else {
             break;
         };
         if world.transmission_off && bs.flags.is_transmission() {
@@ -460,7 +487,7 @@ where
             S::terminate_secondary(&mut path.film);
         }
         path.scatter(&bs, sb.p, sb.inside);
-        if POL {
+        if POL && crystal.is_none() {
             polarise(&mut pol, &mut path, &sb, &bs, wo, wo_local.z > 0.0);
         }
         path.platelet = match hit {

@@ -131,6 +131,30 @@ pub struct World {
     /// The camera's analyser, an ideal linear polariser: its transmission axis (world, unit, in
     /// the image plane). It passes half of unpolarised light, polarised transport or not.
     pub analyser: Option<Vec3>,
+    /// A doubly refractive body's optics, in polarised transport (otherwise the body is
+    /// isotropic with its ordinary index).
+    pub crystal: Option<CrystalOptics>,
+}
+
+/// The optics of a uniaxial body in world space ([`crate::polarisation::crystal`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CrystalOptics {
+    /// Ordinary index at the d line.
+    pub no: f32,
+    /// Birefringence `n_e − n_o` at the d line, kept at every wavelength.
+    pub birefringence: f32,
+    /// Unit optic axis, world space.
+    pub axis: Vec3,
+    /// Dichroic absorption per world unit of the ordinary wave and of the extraordinary wave
+    /// across the axis (zero: not pleochroic).
+    pub sigma: [Rgb; 2],
+}
+
+impl CrystalOptics {
+    /// Whether the absorption depends on the wave.
+    pub fn pleochroic(&self) -> bool {
+        !(self.sigma[0].is_black() && self.sigma[1].is_black())
+    }
 }
 
 /// The axis of the camera's analyser (world, unit) from its angle, radians from the image's right
@@ -218,9 +242,27 @@ impl World {
         // exact only for a single crossing toward unpolarised light (module docs of
         // `crate::polarisation::transport`); otherwise BSDF sampling alone finds those lights.
         let polarised = scene.effects.on(Effect::Polarisation);
+        let crystal = (polarised && shows_body)
+            .then(|| body.and_then(|b| b.crystal.map(|c| (b.ior, c))))
+            .flatten()
+            .map(|(ior, c)| {
+                // Coefficients per object unit become per world unit (the stage's scale).
+                let scale = stage
+                    .to_world
+                    .matrix3
+                    .x_axis
+                    .length()
+                    .max(f32::MIN_POSITIVE);
+                CrystalOptics {
+                    no: ior,
+                    birefringence: c.ne - ior,
+                    axis: stage.to_world.transform_vector3(c.axis).normalize(),
+                    sigma: [c.sigma_o * (1.0 / scale), c.sigma_e * (1.0 / scale)],
+                }
+            });
         if polarised && let Some(m) = inside.manifold.as_mut() {
             m.through = false;
-            m.inside &= areas.iter().all(|a| a.polariser().is_none());
+            m.inside &= areas.iter().all(|a| a.polariser().is_none()) && crystal.is_none();
             if !m.inside {
                 inside.manifold = None;
             }
@@ -255,6 +297,7 @@ impl World {
             bounds,
             polarised,
             analyser: stage.analyser.map(|a| analyser_axis(&stage.camera, a)),
+            crystal,
         })
     }
 

@@ -40,6 +40,21 @@ pub struct Body {
     /// The layered materials of platelet faces, by name, each with the body's IOR as its outside
     /// medium.
     pub platelet_materials: Vec<(String, StackDesc)>,
+    /// A doubly refractive crystal (`ior` is then its ordinary index); `None`: isotropic.
+    pub crystal: Option<Crystal>,
+}
+
+/// The optics of a uniaxial body (object space).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Crystal {
+    /// Extraordinary index ε at the d line (the ordinary one is the body's `ior`).
+    pub ne: f32,
+    /// Unit optic axis, object space.
+    pub axis: glam::Vec3,
+    /// Absorption per object unit of the ordinary wave, on top of the medium's.
+    pub sigma_o: Rgb,
+    /// Absorption per object unit of the extraordinary wave across the axis.
+    pub sigma_e: Rgb,
 }
 
 /// A homogeneous interior as the recipe gives it (per object unit).

@@ -60,6 +60,7 @@ fn interfaces() -> Vec<(String, RoughDielectric, RoughDielectric)> {
                 medium: None,
                 platelets: vec![],
                 platelet_materials: vec![],
+                crystal: None,
             };
             let Bsdf::Dielectric(full) = body.boundary() else {
                 panic!("a rough body has a rough boundary")

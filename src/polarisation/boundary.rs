@@ -1,0 +1,478 @@
+//! The boundary between an isotropic medium and a uniaxial crystal: the two reflected and two
+//! transmitted waves of any incident wave, from the continuity of the tangential electric and
+//! magnetic fields (Born & Wolf, *Principles of Optics*, 7th ed., §1.1.3; Yariv & Yeh, *Optical
+//! Waves in Crystals*, 1984, §4.7, whose 4 × 4 boundary problem this solves directly).
+//!
+//! Units: wave vectors in units of the vacuum wave number (`|k|` is a wave's index), non-magnetic
+//! media, so a plane wave's magnetic field is `H = k × E` and its power flux through the boundary
+//! `Re(E × H*) · n`. Every wave shares the incident wave's tangential wave vector (phase matching);
+//! its normal component solves the medium's dispersion relation — complex for an evanescent wave,
+//! which carries no power. The isotropic side's fields use the s/p frames of
+//! [`super`] (`x` along s, `y = d × s`), so its amplitudes are Jones components.
+//!
+//! Checked against the Fresnel equations (an index-matched crystal is isotropic), the
+//! normal-incidence reflectance along and across an optic axis in the surface, energy
+//! conservation for random crystals, axes and directions, and reciprocity.
+
+use super::uniaxial::Uniaxial;
+use glam::DVec3;
+use num_complex::Complex64 as C;
+
+/// A complex 3-vector.
+type CVec = [C; 3];
+
+fn cv(v: DVec3) -> CVec {
+    [C::from(v.x), C::from(v.y), C::from(v.z)]
+}
+fn add(a: CVec, b: CVec) -> CVec {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+fn scale(a: CVec, s: C) -> CVec {
+    [a[0] * s, a[1] * s, a[2] * s]
+}
+/// The bilinear (not Hermitian) dot product.
+fn dot(a: CVec, b: CVec) -> C {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+fn cross(a: CVec, b: CVec) -> CVec {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+fn norm(a: CVec) -> f64 {
+    a.iter().map(|c| c.norm_sqr()).sum::<f64>().sqrt()
+}
+fn real(a: CVec) -> DVec3 {
+    DVec3::new(a[0].re, a[1].re, a[2].re)
+}
+
+/// A wave's kind: s or p on the isotropic side, ordinary or extraordinary in the crystal.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Mode {
+    /// Isotropic side, electric field across the plane of incidence.
+    S,
+    /// Isotropic side, electric field in the plane of incidence.
+    P,
+    /// Crystal, ordinary wave.
+    O,
+    /// Crystal, extraordinary wave.
+    E,
+}
+
+/// A plane wave at the boundary.
+#[derive(Clone, Copy, Debug)]
+pub struct Wave {
+    /// Its kind.
+    pub mode: Mode,
+    /// Wave vector (complex normal component when evanescent).
+    pub k: CVec,
+    /// Electric field for unit amplitude (unit length where the wave is propagating).
+    pub e: CVec,
+    /// Magnetic field `k × e`.
+    pub h: CVec,
+}
+
+impl Wave {
+    fn new(mode: Mode, k: CVec, e: CVec) -> Wave {
+        Wave {
+            mode,
+            k,
+            e,
+            h: cross(k, e),
+        }
+    }
+
+    /// Power flux of unit amplitude through the boundary along the unit `n`.
+    pub fn flux(&self, n: DVec3) -> f64 {
+        let s = cross(self.e, self.h.map(|c| c.conj()));
+        real(s).dot(n)
+    }
+
+    /// Whether it propagates (a real wave vector).
+    pub fn propagating(&self) -> bool {
+        self.k
+            .iter()
+            .all(|c| c.im.abs() <= 1e-12 * (1.0 + c.re.abs()))
+    }
+
+    /// Its unit wave-vector direction (real part).
+    pub fn direction(&self) -> DVec3 {
+        real(self.k).normalize_or_zero()
+    }
+}
+
+/// One outgoing wave of a solved boundary problem.
+#[derive(Clone, Copy, Debug)]
+pub struct Outgoing {
+    /// The wave (unit-amplitude fields).
+    pub wave: Wave,
+    /// Its complex amplitude for a unit-amplitude incident wave.
+    pub amplitude: C,
+    /// Its share of the incident power (0 when evanescent).
+    pub power: f64,
+}
+
+/// The boundary: an isotropic medium of index `n1` on the side the unit `normal` points to, the
+/// crystal on the other.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Boundary {
+    /// The crystal.
+    pub crystal: Uniaxial,
+    /// Index of the isotropic medium.
+    pub n1: f64,
+    /// Unit normal pointing into the isotropic medium.
+    pub normal: DVec3,
+}
+
+/// The incident wave of a boundary problem.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Incident {
+    /// From the isotropic side along the unit `dir` (toward the crystal), polarised `mode`
+    /// (`S` or `P`).
+    Outside {
+        /// Propagation direction, unit, `dir · normal < 0`.
+        dir: DVec3,
+        /// `Mode::S` or `Mode::P`.
+        mode: Mode,
+    },
+    /// From inside the crystal: the wave of `mode` (`O` or `E`) whose wave vector points along
+    /// the unit `dir` (toward the boundary, `dir · normal > 0`).
+    Inside {
+        /// Wave-vector direction, unit.
+        dir: DVec3,
+        /// `Mode::O` or `Mode::E`.
+        mode: Mode,
+    },
+}
+
+impl Boundary {
+    /// The s direction for tangential wave vector `t`: `normal × t`, or `reference` (made
+    /// tangential) at normal incidence.
+    pub fn s_axis(&self, t: DVec3, reference: DVec3) -> DVec3 {
+        let n = self.normal;
+        n.cross(t).try_normalize().unwrap_or_else(|| {
+            (reference - n * reference.dot(n))
+                .try_normalize()
+                .unwrap_or_else(|| n.any_orthonormal_vector())
+        })
+    }
+
+    /// The isotropic side's wave of `mode` with tangential `t`, going away from the boundary
+    /// (`up`) or toward it.
+    fn isotropic(&self, t: DVec3, s: DVec3, mode: Mode, up: bool) -> Wave {
+        let q = C::from(self.n1 * self.n1 - t.length_squared()).sqrt();
+        let q = if up { q } else { -q };
+        let k = add(cv(t), scale(cv(self.normal), q));
+        let e = match mode {
+            Mode::S => cv(s),
+            _ => scale(cross(k, cv(s)), C::from(1.0 / self.n1)),
+        };
+        Wave::new(mode, k, e)
+    }
+
+    /// The crystal's wave of `mode` with tangential `t`, going away from the boundary (down,
+    /// decaying into the crystal when evanescent) or toward it (`up`, propagating).
+    fn crystal_wave(&self, t: DVec3, mode: Mode, up: bool, s: DVec3) -> Wave {
+        let x = &self.crystal;
+        let (n, c) = (self.normal, x.axis);
+        let (io, ie) = (1.0 / (x.no * x.no), 1.0 / (x.ne * x.ne));
+        // The normal component u of k = t + u n.
+        let u = match mode {
+            Mode::O => {
+                let q = C::from(x.no * x.no - t.length_squared()).sqrt();
+                if up { q } else { -q }
+            }
+            _ => {
+                // (a + u b)² io + (|t|² + u² − (a + u b)²) ie = 1; the root with `+√` carries
+                // energy along +n (the index surface's normal has n-component u·qa + qb/2).
+                let (a, b) = (t.dot(c), n.dot(c));
+                let qa = b * b * (io - ie) + ie;
+                let qb = 2.0 * a * b * (io - ie);
+                let qc = a * a * (io - ie) + t.length_squared() * ie - 1.0;
+                let root = C::from(qb * qb - 4.0 * qa * qc).sqrt();
+                let root = if up { root } else { -root };
+                (root - qb) / (2.0 * qa)
+            }
+        };
+        let k = add(cv(t), scale(cv(n), u));
+        let cc = cv(c);
+        let kc = cross(k, cc);
+        // Along the axis both waves are ordinary: take the s direction for one and the field
+        // across it for the other.
+        let degenerate = norm(kc) <= 1e-9 * norm(k);
+        let e = match mode {
+            Mode::O if degenerate => cv(s),
+            Mode::O => scale(kc, C::from(1.0 / norm(kc))),
+            _ => {
+                let d = if degenerate {
+                    cross(k, cv(s))
+                } else {
+                    // D ⟂ k in the plane of k and c; E = ε⁻¹ D.
+                    add(scale(cc, dot(k, k)), scale(k, -dot(k, cc)))
+                };
+                let e = add(scale(d, C::from(io)), scale(cc, dot(cc, d) * (ie - io)));
+                scale(e, C::from(1.0 / norm(e).max(f64::MIN_POSITIVE)))
+            }
+        };
+        Wave::new(mode, k, e)
+    }
+
+    /// Solves the boundary for `incident`: the two waves leaving on the isotropic side (`S`,
+    /// `P`) and the two leaving into the crystal (`O`, `E`), in that order, with amplitudes and
+    /// power shares; `reference` fixes the s axis at normal incidence. `None` if the problem is
+    /// singular (a grazing wave).
+    pub fn solve(&self, incident: Incident, reference: DVec3) -> Option<[Outgoing; 4]> {
+        let n = self.normal;
+        let (dir, inc_mode) = match incident {
+            Incident::Outside { dir, mode } | Incident::Inside { dir, mode } => (dir, mode),
+        };
+        let index = match incident {
+            Incident::Outside { .. } => self.n1,
+            Incident::Inside { dir, mode } => match mode {
+                Mode::O => self.crystal.no,
+                _ => self.crystal.extraordinary_index(dir),
+            },
+        };
+        let t = index * (dir - n * dir.dot(n));
+        let s = self.s_axis(t, reference);
+        let inc = match incident {
+            Incident::Outside { .. } => self.isotropic(t, s, inc_mode, false),
+            Incident::Inside { .. } => self.crystal_wave(t, inc_mode, true, s),
+        };
+        let out = [
+            self.isotropic(t, s, Mode::S, true),
+            self.isotropic(t, s, Mode::P, true),
+            self.crystal_wave(t, Mode::O, false, s),
+            self.crystal_wave(t, Mode::E, false, s),
+        ];
+        // Tangential E and H continuous: Σ(isotropic side) = Σ(crystal side). Unknowns: the four
+        // outgoing amplitudes; the incident wave sits on its own side.
+        let t1 = cv(s);
+        let t2 = cv(n.cross(s));
+        let rows = |w: &Wave| [dot(w.e, t1), dot(w.e, t2), dot(w.h, t1), dot(w.h, t2)];
+        let mut a = [[C::from(0.0); 5]; 4];
+        for (j, w) in out.iter().enumerate() {
+            let sign = if j < 2 { 1.0 } else { -1.0 };
+            for (i, v) in rows(w).into_iter().enumerate() {
+                a[i][j] = v * sign;
+            }
+        }
+        let inc_sign = match incident {
+            Incident::Outside { .. } => -1.0,
+            Incident::Inside { .. } => 1.0,
+        };
+        for (i, v) in rows(&inc).into_iter().enumerate() {
+            a[i][4] = v * inc_sign;
+        }
+        let x = solve4(a)?;
+        let flux_in = inc.flux(n).abs();
+        if !(flux_in > 0.0) {
+            return None;
+        }
+        Some(std::array::from_fn(|j| {
+            let w = out[j];
+            let power = if w.propagating() {
+                x[j].norm_sqr() * w.flux(n).abs() / flux_in
+            } else {
+                0.0
+            };
+            Outgoing {
+                wave: w,
+                amplitude: x[j],
+                power,
+            }
+        }))
+    }
+}
+
+/// Gaussian elimination with partial pivoting on an augmented 4 × 5 system.
+fn solve4(mut a: [[C; 5]; 4]) -> Option<[C; 4]> {
+    for col in 0..4 {
+        let p = (col..4).max_by(|&i, &j| a[i][col].norm().total_cmp(&a[j][col].norm()))?;
+        if !(a[p][col].norm() > 1e-14) {
+            return None;
+        }
+        a.swap(col, p);
+        let pivot = a[col];
+        for (r, row) in a.iter_mut().enumerate() {
+            if r != col {
+                let f = row[col] / pivot[col];
+                for (x, v) in row.iter_mut().zip(pivot).skip(col) {
+                    *x -= f * v;
+                }
+            }
+        }
+    }
+    let x: [C; 4] = std::array::from_fn(|i| a[i][4] / a[i][i]);
+    x.iter().all(|c| c.is_finite()).then_some(x)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::polarisation::fresnel;
+    use crate::sampler::Rng;
+
+    fn random_unit(rng: &mut Rng) -> DVec3 {
+        let z = 2.0 * f64::from(rng.uniform()) - 1.0;
+        let phi = std::f64::consts::TAU * f64::from(rng.uniform());
+        let r = (1.0 - z * z).sqrt();
+        DVec3::new(r * phi.cos(), r * phi.sin(), z)
+    }
+
+    fn boundary(no: f64, ne: f64, axis: DVec3) -> Boundary {
+        Boundary {
+            crystal: Uniaxial {
+                no,
+                ne,
+                axis: axis.normalize(),
+            },
+            n1: 1.0,
+            normal: DVec3::Z,
+        }
+    }
+
+    /// With `n_o = n_e` the crystal is isotropic glass: reflected s and p powers are Fresnel's
+    /// (scalar formulas of `fresnel::amplitudes`), nothing converts s into p, and the crystal's
+    /// two waves share the transmitted power.
+    #[test]
+    fn an_index_matched_crystal_is_fresnel() {
+        let mut rng = Rng::new(5);
+        for _ in 0..200 {
+            let b = boundary(1.6, 1.6, random_unit(&mut rng));
+            let cos = 0.02 + 0.97 * f64::from(rng.uniform());
+            let dir = DVec3::new((1.0 - cos * cos).sqrt(), 0.0, -cos);
+            let amp = fresnel::amplitudes(cos, C::from(1.6));
+            for (mode, r) in [(Mode::S, amp.rs), (Mode::P, amp.rp)] {
+                let out = b.solve(Incident::Outside { dir, mode }, DVec3::X).unwrap();
+                let (same, other) = if mode == Mode::S { (0, 1) } else { (1, 0) };
+                assert!(
+                    (out[same].power - r.norm_sqr()).abs() < 1e-9,
+                    "{cos} {mode:?}"
+                );
+                assert!(out[other].power < 1e-12);
+                let t = out[2].power + out[3].power;
+                assert!((t + r.norm_sqr() - 1.0).abs() < 1e-9, "{cos}: {t}");
+            }
+        }
+    }
+
+    /// At normal incidence on a crystal cut parallel to its axis, light polarised along the axis
+    /// meets `n_e` and across it `n_o`: `R = ((n − 1)/(n + 1))²` each, and nothing converts.
+    #[test]
+    fn normal_incidence_along_and_across_the_axis() {
+        let (no, ne) = (1.6584, 1.4864);
+        let b = boundary(no, ne, DVec3::X);
+        let dir = DVec3::NEG_Z;
+        // s along the reference X: along the axis.
+        let along = b
+            .solve(Incident::Outside { dir, mode: Mode::S }, DVec3::X)
+            .unwrap();
+        let want = ((ne - 1.0) / (ne + 1.0)).powi(2);
+        assert!((along[0].power - want).abs() < 1e-12, "{}", along[0].power);
+        assert!(along[2].power < 1e-12 && (along[3].power - (1.0 - want)).abs() < 1e-12);
+        let across = b
+            .solve(Incident::Outside { dir, mode: Mode::S }, DVec3::Y)
+            .unwrap();
+        let want = ((no - 1.0) / (no + 1.0)).powi(2);
+        assert!(
+            (across[0].power - want).abs() < 1e-12,
+            "{}",
+            across[0].power
+        );
+        assert!(across[3].power < 1e-12 && (across[2].power - (1.0 - want)).abs() < 1e-12);
+    }
+
+    /// Energy is conserved for every incident wave, crystal and axis, inside and out (calcite and
+    /// a positive crystal), total internal reflection included.
+    #[test]
+    fn power_is_conserved() {
+        let mut rng = Rng::new(9);
+        let mut solved = 0;
+        for i in 0..4000 {
+            let (no, ne) = if i % 2 == 0 {
+                (1.6584, 1.4864)
+            } else {
+                (1.544, 1.553)
+            };
+            let b = boundary(no, ne, random_unit(&mut rng));
+            let mut d = random_unit(&mut rng);
+            let inside = i % 4 >= 2;
+            let incident = if inside {
+                d.z = d.z.abs();
+                let mode = if rng.uniform() < 0.5 {
+                    Mode::O
+                } else {
+                    Mode::E
+                };
+                // An e wave vector whose energy does not reach the boundary is not incident.
+                if mode == Mode::E {
+                    let k = b.crystal.extraordinary_index(d) * d;
+                    if b.crystal.ray(k).z <= 1e-6 {
+                        continue;
+                    }
+                }
+                Incident::Inside { dir: d, mode }
+            } else {
+                d.z = -d.z.abs();
+                let mode = if rng.uniform() < 0.5 {
+                    Mode::S
+                } else {
+                    Mode::P
+                };
+                Incident::Outside { dir: d, mode }
+            };
+            let Some(out) = b.solve(incident, DVec3::X) else {
+                continue;
+            };
+            solved += 1;
+            let total: f64 = out.iter().map(|o| o.power).sum();
+            assert!((total - 1.0).abs() < 1e-8, "{incident:?}: {total} {out:?}");
+        }
+        assert!(solved > 3500, "{solved}");
+    }
+
+    /// Reciprocity: the power an s or p wave from outside sends into an ordinary or
+    /// extraordinary wave equals what that crystal wave, reversed, sends into the reversed s or
+    /// p wave (the symmetric scattering matrix of a lossless reciprocal boundary).
+    #[test]
+    fn transmission_is_reciprocal() {
+        let mut rng = Rng::new(21);
+        for _ in 0..500 {
+            let b = boundary(1.6584, 1.4864, random_unit(&mut rng));
+            let mut d = random_unit(&mut rng);
+            d.z = -d.z.abs().max(0.05);
+            let d = d.normalize();
+            for mode in [Mode::S, Mode::P] {
+                let fwd = b
+                    .solve(Incident::Outside { dir: d, mode }, DVec3::X)
+                    .unwrap();
+                for j in [2, 3] {
+                    let w = fwd[j].wave;
+                    if !w.propagating() || fwd[j].power < 1e-9 {
+                        continue;
+                    }
+                    let back = b
+                        .solve(
+                            Incident::Inside {
+                                dir: -w.direction(),
+                                mode: w.mode,
+                            },
+                            DVec3::X,
+                        )
+                        .unwrap();
+                    let i = if mode == Mode::S { 0 } else { 1 };
+                    assert!(
+                        (back[i].power - fwd[j].power).abs() < 1e-7,
+                        "{mode:?}→{:?}: {} vs {}",
+                        w.mode,
+                        fwd[j].power,
+                        back[i].power
+                    );
+                }
+            }
+        }
+    }
+}
