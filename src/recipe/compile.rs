@@ -464,16 +464,23 @@ impl Compiler<'_> {
     /// caustic. Not for a dispersive body: the walks solve Snell's law with one index, and a
     /// spectral path refracts each wavelength its own way (there light is found by BSDF sampling).
     /// Nor for a doubly refractive body, whose boundary splits light into two waves the walk
-    /// does not follow.
+    /// does not follow; and in polarised transport, whose Stokes rows the walks' scalar chains
+    /// do not carry, neither the caustics nor, under a polarised light, the walks from inside.
     fn manifold_effect(&mut self, body: &Body, stage: &crate::scene::stage::Stage) {
         if body.dispersion.is_some() || body.crystal.is_some() {
             return;
         }
+        let polarised = self.effects.called(Effect::Polarisation);
+        let polarised_light = stage.lights.iter().any(|l| l.polariser.is_some());
         let r = self.recipe;
         let scatters_inside = !body.platelets.is_empty()
             || body.medium.is_some_and(|m| m.sigma_s.max_channel() > 0.0);
         let lit = stage.lights.iter().any(|l| l.radiance.max_channel() > 0.0);
-        if self.effects.called(Effect::Transmission) && body.alpha == 0.0 && scatters_inside && lit
+        if self.effects.called(Effect::Transmission)
+            && body.alpha == 0.0
+            && scatters_inside
+            && lit
+            && !(polarised && polarised_light)
         {
             let at = r.source.find(&["body", ":"]);
             let e = r.source.error(at, "");
@@ -495,6 +502,7 @@ impl Compiler<'_> {
         if self.effects.called(Effect::Transmission)
             && body.alpha == 0.0
             && lit
+            && !polarised
             && let Some(g) = stage
                 .ground
                 .as_ref()

@@ -96,6 +96,14 @@ impl Scene {
                 );
             }
         }
+        // Polarised transport (forced on here) has no manifold walks where their scalar chains
+        // would miss the Stokes row (the recipe compiler's rule, `manifold_effect`).
+        if self.effects.on(Effect::Polarisation) {
+            self.effects.clear(Effect::ManifoldCaustics);
+            if self.stage.lights.iter().any(|l| l.polariser.is_some()) {
+                self.effects.clear(Effect::ManifoldNee);
+            }
+        }
         self.accuracy.model = acc.model.or(self.accuracy.model);
         self.accuracy.fresnel = acc.fresnel.or(self.accuracy.fresnel);
         Ok(())
