@@ -193,6 +193,23 @@ pub fn describe(recipe: &GemRecipe, scene: &Scene, points: u32) -> String {
                 law.abbe()
             ),
         };
+        // A doubly refractive body: `ior` is ω.
+        let ior = match &b.crystal {
+            None => ior,
+            Some(c) => format!(
+                "ω {ior}, ε {} (uniaxial, axis {:.3?}{})",
+                c.ne,
+                c.axis.to_array(),
+                if c.sigma_o.is_black() && c.sigma_e.is_black() {
+                    String::new()
+                } else {
+                    format!(
+                        "; pleochroic σω {:.3?}, σε {:.3?} per object unit",
+                        c.sigma_o.0, c.sigma_e.0
+                    )
+                }
+            ),
+        };
         let _ = writeln!(
             o,
             "  {i:>3}  {:<width$}  {:>6.2}%  body: IOR {ior}, {boundary} boundary; interior {interior}",
