@@ -354,6 +354,56 @@ fn a_dichroic_plate_shows_each_waves_colour() {
     );
 }
 
+/// The dichroscope: the same plate on the `Dichroscope` stage, its two windows side by side in one
+/// image. The left half (analyser along the image's right, the plate's axis) shows the
+/// extraordinary wave's colour, the right half the ordinary wave's — the closed forms of
+/// [`a_dichroic_plate_shows_each_waves_colour`] — and each half is the whole view: the plate's
+/// edges fall on the same columns of both halves.
+#[test]
+fn the_dichroscope_shows_both_waves_side_by_side() {
+    let (w, h) = (48usize, 24usize);
+    let s = compile(&format!(
+        r#"(materials: {{}}, surface: Body,
+            body: (ior: 1.62, crystal: Uniaxial(ne: 1.62, axis: (1.0, 0.0, 0.0),
+                   pleochroism: (ordinary: Gray(0.2), extraordinary: Gray(0.8), distance: 0.5))),
+            stage: (preset: Dichroscope(), shape: Slab(size: (0.6, 0.5, 0.6)),
+                    transform: (translate: (0.0, 0.3, 0.0)),
+                    lights: [Rect(center: (0.0, -1.0, 0.0), target: (0.0, 0.0, 0.0),
+                                  size: (20.0, 20.0), radiance: Gray(1.0))],
+                    camera: Orthographic(from: (0.0, 5.0, 0.0), to: (0.0, 0.0, 0.0),
+                                         up: (0.0, 0.0, -1.0), height: 1.0),
+                    render: (width: {w}, height: {h}, spp: 16, max_depth: 16)))"#
+    ));
+    assert!(s.stage.dichroscope && s.effects.on(Effect::Polarisation));
+    let world = World::new(&s).expect("world");
+    let img = render_scene(&world, &s, &Control::default()).film.rgb();
+    let r = ((1.62f64 - 1.0) / 2.62).powi(2);
+    let t2 = (1.0 - r).powi(2);
+    // The plate covers the middle 0.6 of the unit view: columns and rows 6..18 of each half.
+    let inside = |x: usize, y: usize| (7..17).contains(&(x % (w / 2))) && (7..17).contains(&y);
+    for (half, tau) in [(0usize, 0.8f64), (1, 0.2)] {
+        let v: Vec<f64> = (0..h)
+            .flat_map(|y| (0..w / 2).map(move |x| (x + half * w / 2, y)))
+            .filter(|&(x, y)| inside(x, y))
+            .map(|(x, y)| f64::from(img[y * w + x][0]))
+            .collect();
+        let n = v.len() as f64;
+        let m = v.iter().sum::<f64>() / n;
+        let se = (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt();
+        let want = 0.5 * t2 * (tau + tau.powi(3) * r * r);
+        eprintln!("half {half}: {m:.5} ± {se:.5} (closed form {want:.5})");
+        assert!(
+            (m - want).abs() < 1e-3 * want + 5.0 * se,
+            "half {half}: {m} vs {want}"
+        );
+        // Around the plate both windows see the light box through their analyser: ½.
+        for (x, y) in [(1usize, 1usize), (22, 22)] {
+            let p = img[y * w + x + half * w / 2][0];
+            assert!((p - 0.5).abs() < 1e-4, "half {half} ({x}, {y}): {p}");
+        }
+    }
+}
+
 /// Polarised renders with crystals are deterministic: the pleochroic sunstone renders
 /// bit-identically on 1 and 2 threads.
 #[test]

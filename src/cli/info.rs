@@ -389,10 +389,19 @@ pub fn describe(recipe: &GemRecipe, scene: &Scene, points: u32) -> String {
         "  camera       {proj}, from {:.2?} looking {:.3?}{}",
         cam.from.to_array(),
         cam.forward.to_array(),
-        st.analyser.map_or(String::new(), |a| format!(
-            ", through a linear analyser at {:.1}° from the image's right",
-            a.to_degrees()
-        ))
+        st.analyser.map_or(String::new(), |a| if st.dichroscope {
+            format!(
+                ", a dichroscope: the left half through a linear analyser at {:.1}° from the \
+                 image's right, the right half (the same view) through one at {:.1}°",
+                a.to_degrees(),
+                a.to_degrees() + 90.0
+            )
+        } else {
+            format!(
+                ", through a linear analyser at {:.1}° from the image's right",
+                a.to_degrees()
+            )
+        })
     );
     let r = &st.render;
     let _ = writeln!(

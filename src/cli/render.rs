@@ -90,6 +90,11 @@ pub struct RenderArgs {
     /// because it is faster today (the lane loop's phases are not all vectorised yet).
     #[arg(long, value_parser = super::knobs::switch_arg)]
     pub lanes: Option<bool>,
+    /// Also measure the Stokes vector of the light reaching the camera, before any analyser, and
+    /// write it as the AOVs `S0`–`S3` (RGB each; frame: the image's right and up). Turns
+    /// polarised transport on; one pass measures all four (docs/polarisation.md).
+    #[arg(long)]
+    pub stokes: bool,
     /// No progress bar and no summary.
     #[arg(short, long)]
     pub quiet: bool,
@@ -216,6 +221,23 @@ fn settings(args: &RenderArgs, scene: &mut Scene) {
     if let Some(v) = &args.view {
         v.apply(&mut scene.stage);
     }
+    scene.stage.stokes = args.stokes;
+}
+
+/// The accuracy knobs of the command line, with polarised transport forced on by `--stokes`.
+fn accuracy(args: &RenderArgs) -> Result<crate::scene::accuracy::Accuracy> {
+    use crate::scene::Effect;
+    let mut acc = args.knobs.accuracy().map_err(anyhow::Error::msg)?;
+    if args.stokes {
+        if acc.forced(Effect::Polarisation) == Some(false) {
+            bail!(
+                "--stokes contradicts --polarised off: the Stokes AOVs are measured by polarised \
+                 transport"
+            );
+        }
+        acc.force(Effect::Polarisation, true);
+    }
+    Ok(acc)
 }
 
 /// Runs `lapidary render`; returns whether the render was interrupted by Ctrl-C or SIGTERM
@@ -229,7 +251,15 @@ pub fn run(args: &RenderArgs) -> Result<bool> {
         // A part's metadata does not record the view, so `merge` could not tell parts of two
         // views apart: refused rather than merged wrongly.
         bail!(
-            "--view with --samples: part renders do not record the view; render the whole image              with --view, or put the camera in the recipe for a farm render"
+            "--view with --samples: part renders do not record the view; render the whole image \
+             with --view, or put the camera in the recipe for a farm render"
+        );
+    }
+    if args.samples.is_some() && args.stokes {
+        // A part file carries the radiance's exact sums only: the merge would drop the AOVs.
+        bail!(
+            "--stokes with --samples: part renders do not carry the Stokes sums yet; render the \
+             whole image with --stokes"
         );
     }
     let (exr_path, png_path) = outputs(args)?;
@@ -240,11 +270,7 @@ pub fn run(args: &RenderArgs) -> Result<bool> {
         Some(p) => Some(plan.output(p, Format::Png)?),
         None => None,
     };
-    let loaded = super::load::load_scene(
-        &args.recipe,
-        &args.knobs.accuracy().map_err(anyhow::Error::msg)?,
-        Some(&mut plan),
-    )?;
+    let loaded = super::load::load_scene(&args.recipe, &accuracy(args)?, Some(&mut plan))?;
     let mut scene = loaded.scene;
     settings(args, &mut scene);
     // A range past the render's samples is refused before any setup.

@@ -27,6 +27,7 @@ pub mod crystal;
 pub mod fresnel;
 pub mod interference;
 pub mod mueller;
+pub mod stokes;
 pub mod transport;
 pub mod uniaxial;
 

@@ -97,15 +97,19 @@ impl PathPolarisation {
     /// is orthogonal), by twice the angle from the old axis to the new one.
     pub fn rotate_to(&mut self, x_new: Vec3, d: Vec3) {
         if !self.is_unpolarised() {
-            let phi = self.x.cross(x_new).dot(d).atan2(self.x.dot(x_new));
-            let (s, c) = (2.0 * phi).sin_cos();
-            for w in &mut self.w {
-                let (a, b) = (w[0], w[1]);
-                w[0] = c * a + s * b;
-                w[1] = -s * a + c * b;
-            }
+            self.rotate_by(turn(self.x, x_new, d));
         }
         self.x = x_new;
+    }
+
+    /// Turns the ratios by a [`turn`] (the frame's axis is the caller's to set).
+    #[inline]
+    fn rotate_by(&mut self, [c, s]: [f32; 2]) {
+        for w in &mut self.w {
+            let (a, b) = (w[0], w[1]);
+            w[0] = c * a + s * b;
+            w[1] = -s * a + c * b;
+        }
     }
 
     /// A specular event at an interface with unit normal `n` (either sign): the light leaves along
@@ -121,27 +125,37 @@ impl PathPolarisation {
         eta: [Option<f32>; MAX_CHANNELS],
         kind: Interface,
     ) -> [f32; MAX_CHANNELS] {
-        // `s` is normal to the plane of incidence; at normal incidence every axis is one.
-        let s = n.cross(wo).try_normalize().unwrap_or_else(|| {
-            (self.x - wo * self.x.dot(wo))
-                .try_normalize()
-                .unwrap_or_else(|| wo.any_orthonormal_vector())
-        });
-        self.rotate_to(s, wo);
-        let cos_i = f64::from(wi.dot(n).abs()).min(1.0);
-        let mut k = [0.0; MAX_CHANNELS];
-        for c in 0..MAX_CHANNELS {
-            let Some(e) = eta[c] else {
-                self.w[c] = [0.0; 3];
-                continue;
-            };
-            let m = match kind {
-                Interface::Reflection => Some(fresnel::dielectric_reflection(cos_i, f64::from(e))),
-                Interface::Refraction => fresnel::dielectric_transmission(cos_i, f64::from(e)),
-            };
-            k[c] = self.apply(c, m.as_ref());
+        let event = InterfaceEvent::new(n, wo, wi, eta, kind, self.x);
+        self.take(&event)
+    }
+
+    /// The row's update by an interface event computed once ([`InterfaceEvent::new`]): what
+    /// [`PathPolarisation::interface`] does, for rows that share an event (the Stokes AOVs').
+    pub fn take(&mut self, e: &InterfaceEvent) -> [f32; MAX_CHANNELS] {
+        self.rotate_to(e.s, e.wo);
+        self.take_in_frame(e)
+    }
+
+    /// [`PathPolarisation::take`] for a row already turned by `t`, the [`turn`] from its axis to
+    /// the event's (rows sharing a frame compute the turn once).
+    pub fn take_turned(&mut self, e: &InterfaceEvent, t: [f32; 2]) -> [f32; MAX_CHANNELS] {
+        if !self.is_unpolarised() {
+            self.rotate_by(t);
         }
-        self.x = s;
+        self.x = e.s;
+        self.take_in_frame(e)
+    }
+
+    /// The event's matrices applied to a row in the event's frame.
+    fn take_in_frame(&mut self, e: &InterfaceEvent) -> [f32; MAX_CHANNELS] {
+        let mut k = [0.0; MAX_CHANNELS];
+        for (c, m) in e.m.iter().enumerate() {
+            match m {
+                None => self.w[c] = [0.0; 3],
+                Some(m) => k[c] = self.apply(c, m.as_ref()),
+            }
+        }
+        self.x = e.s;
         k
     }
 
@@ -188,6 +202,61 @@ impl PathPolarisation {
         let mut row = *self;
         row.rotate_to(x_light, d);
         row.w.map(|w| (1.0 + w[0]).max(0.0))
+    }
+
+    /// [`PathPolarisation::polarised_emission`] for a row whose frame has already been related to
+    /// the light's by `t`, the [`turn`] to the polariser's axis.
+    pub fn polarised_emission_turned(&self, [c, s]: [f32; 2]) -> [f32; MAX_CHANNELS] {
+        self.w.map(|w| (1.0 + (c * w[0] + s * w[1])).max(0.0))
+    }
+}
+
+/// `(cos 2φ, sin 2φ)` of the angle `φ` from frame axis `from` to `to`, both unit and orthogonal
+/// to the propagation direction `d` (the rotator a row or Stokes vector takes between them).
+#[inline]
+pub fn turn(from: Vec3, to: Vec3, d: Vec3) -> [f32; 2] {
+    let phi = from.cross(to).dot(d).atan2(from.dot(to));
+    let (s, c) = (2.0 * phi).sin_cos();
+    [c, s]
+}
+
+/// An interface event's frame and Fresnel matrices per channel, computed once for every row that
+/// takes it ([`PathPolarisation::take`]).
+#[derive(Clone, Copy, Debug)]
+pub struct InterfaceEvent {
+    /// The s axis (normal of the plane of incidence), the frame's axis after the event.
+    pub(super) s: Vec3,
+    /// The direction the light leaves along.
+    pub(super) wo: Vec3,
+    /// Per channel: `None` for a channel the path no longer carries, `Some(None)` where nothing
+    /// passes (total internal reflection for a refraction), else the Mueller matrix.
+    m: [Option<Option<Mueller>>; MAX_CHANNELS],
+}
+
+impl InterfaceEvent {
+    /// The event of [`PathPolarisation::interface`] (same arguments); `x` is a row's current axis,
+    /// which fixes the s axis at normal incidence (where every axis is one).
+    pub fn new(
+        n: Vec3,
+        wo: Vec3,
+        wi: Vec3,
+        eta: [Option<f32>; MAX_CHANNELS],
+        kind: Interface,
+        x: Vec3,
+    ) -> InterfaceEvent {
+        let s = n.cross(wo).try_normalize().unwrap_or_else(|| {
+            (x - wo * x.dot(wo))
+                .try_normalize()
+                .unwrap_or_else(|| wo.any_orthonormal_vector())
+        });
+        let cos_i = f64::from(wi.dot(n).abs()).min(1.0);
+        let m = eta.map(|e| {
+            e.map(|e| match kind {
+                Interface::Reflection => Some(fresnel::dielectric_reflection(cos_i, f64::from(e))),
+                Interface::Refraction => fresnel::dielectric_transmission(cos_i, f64::from(e)),
+            })
+        });
+        InterfaceEvent { s, wo, m }
     }
 }
 

@@ -31,6 +31,7 @@ pub(crate) fn stage(
     let mut stage = match preset {
         Some(super::stage::StagePreset::Jeweller) => Stage::jeweller(),
         Some(super::stage::StagePreset::Polariscope { crossed, .. }) => Stage::polariscope(crossed),
+        Some(super::stage::StagePreset::Dichroscope { .. }) => Stage::dichroscope(),
         _ => Stage::studio(),
     };
     let n_errors = errors.len();
@@ -350,7 +351,11 @@ pub(crate) fn stage(
     if let Some(a) = desc.analyser {
         stage.analyser = Some(a.to_radians());
     }
-    if let Some(super::stage::StagePreset::Polariscope { rotation, .. }) = preset {
+    if let Some(
+        super::stage::StagePreset::Polariscope { rotation, .. }
+        | super::stage::StagePreset::Dichroscope { rotation },
+    ) = preset
+    {
         stage.to_world = glam::Affine3A::from_rotation_y(rotation.to_radians()) * stage.to_world;
     }
     stage_effects(&stage, effects);
@@ -387,10 +392,16 @@ pub(crate) fn stage_effects(stage: &Stage, effects: &mut Effects) {
     }
     // The analyser first: its reason is what tells the lane loop's check that one is there.
     if let Some(a) = stage.analyser {
-        effects.turn_on(
-            Effect::Polarisation,
-            format!("stage.analyser = {:.1}°", a.to_degrees()),
-        );
+        let reason = if stage.dichroscope {
+            format!(
+                "the Dichroscope's analysers at {:.1}° (left) and {:.1}° (right)",
+                a.to_degrees(),
+                a.to_degrees() + 90.0
+            )
+        } else {
+            format!("stage.analyser = {:.1}°", a.to_degrees())
+        };
+        effects.turn_on(Effect::Polarisation, reason);
     }
     for (i, l) in stage.lights.iter().enumerate() {
         if l.spectrum.is_some() {

@@ -253,6 +253,16 @@ pub enum StagePreset {
         #[serde(default, deserialize_with = "turn_range")]
         rotation: f32,
     },
+    /// The gemmologist's dichroscope ([`crate::scene::Stage::dichroscope`]): the polariscope's
+    /// room lit by unpolarised light, the image split into two views of the stone through
+    /// analysers 90° apart (the stage's `analyser` turns both; default along the image's right).
+    /// Turns polarised transport on.
+    Dichroscope {
+        /// The stone turned about the vertical, degrees, −360 ..= 360 (default 0), after the
+        /// recipe's own `transform`.
+        #[serde(default, deserialize_with = "turn_range")]
+        rotation: f32,
+    },
 }
 
 fn yes() -> bool {

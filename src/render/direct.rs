@@ -25,6 +25,7 @@ pub enum Strategy {
 }
 
 /// Next-event estimation at `sb`: one light sample, weighted against BSDF sampling by `strategy`.
+/// Returns what it added to the path's radiance (zero when nothing).
 #[allow(clippy::too_many_arguments)]
 #[inline]
 pub(super) fn direct_light<S: Spectral>(
@@ -36,25 +37,26 @@ pub(super) fn direct_light<S: Spectral>(
     u_point: glam::Vec2,
     path: &mut PathState<S>,
     out: &mut PathSample,
-) where
+) -> S
+where
     Bsdf: Scatter<S>,
 {
     let Some((light, p_pick)) = world.pick_light(u_light) else {
-        return;
+        return S::ZERO;
     };
     let sample = match light {
         LightRef::Area(i) => world.areas[i].sample(sb.p, u_point),
         LightRef::Environment => world.environment.sample(u_point),
     };
     let Some(ls) = sample else {
-        return;
+        return S::ZERO;
     };
     if !sb.admits(ls.wi) || (world.transmission_off && ls.wi.dot(sb.ng) < 0.0) {
-        return;
+        return S::ZERO;
     }
     let (wi_local, f) = sb.eval::<S>(wo_local, ls.wi, &path.lambda);
     if f.is_black() {
-        return;
+        return S::ZERO;
     }
     let origin = offset_origin(sb.p, sb.ng, ls.wi);
     let t_max = if ls.dist.is_finite() {
@@ -64,7 +66,7 @@ pub(super) fn direct_light<S: Spectral>(
     };
     out.rays += 1;
     if world.occluded(&Ray::new(origin, ls.wi), t_max) {
-        return;
+        return S::ZERO;
     }
     let p_light = p_pick * ls.pdf;
     let w = match strategy {
@@ -77,7 +79,9 @@ pub(super) fn direct_light<S: Spectral>(
     };
     let c = path.throughput() * f * radiance * (wi_local.z.abs() * w / p_light);
     if c.is_valid() {
-        path.gather(c);
+        path.gather(c)
+    } else {
+        S::ZERO
     }
 }
 

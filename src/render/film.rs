@@ -57,8 +57,8 @@ impl PixelSums {
     /// Adds one sample; a sample whose radiance is not finite and non-negative (or beyond
     /// [`fixed::RADIANCE_LIMIT`]) is dropped and counted (its AOVs are kept: they are finite by
     /// construction). Samples must be added in increasing sample order within one film (the
-    /// material AOV keeps the first).
-    pub fn add(&mut self, s: &PathSample) {
+    /// material AOV keeps the first). Returns whether the sample was kept.
+    pub fn add(&mut self, s: &PathSample) -> bool {
         self.rays += u64::from(s.rays);
         if self.material == i32::MIN {
             self.material = s.material;
@@ -80,7 +80,7 @@ impl PixelSums {
         };
         if !ok || s.radiance.0.iter().any(|v| v.abs() > fixed::RADIANCE_LIMIT) {
             self.dropped += 1;
-            return;
+            return false;
         }
         self.n += 1;
         for c in 0..3 {
@@ -88,6 +88,7 @@ impl PixelSums {
             self.sum[c] = self.sum[c].wrapping_add(fixed::radiance(v));
             self.sum_sq[c] = self.sum_sq[c].saturating_add(fixed::square(v));
         }
+        true
     }
 
     /// Adds another part's sums of the same pixel: exact, so the result does not depend on the
@@ -176,6 +177,36 @@ impl PixelSums {
     }
 }
 
+/// The Stokes AOVs' sums of one pixel (`--stokes`, [`crate::polarisation::stokes`]): Σ `S0`…`S3`
+/// per colour channel over the samples the pixel kept, in units of [`fixed::RADIANCE_UNIT`]
+/// (exact and order-independent like the radiance sums).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct StokesSums(pub [[i128; 3]; 4]);
+
+impl StokesSums {
+    /// Adds a kept sample's Stokes vector (a component that is not finite counts as 0, one
+    /// beyond [`fixed::RADIANCE_LIMIT`] as the limit).
+    pub fn add(&mut self, stokes: &[crate::color::Rgb; 4]) {
+        for (sum, v) in self.0.iter_mut().zip(stokes) {
+            for c in 0..3 {
+                let x = if v[c].is_finite() {
+                    v[c].clamp(-fixed::RADIANCE_LIMIT, fixed::RADIANCE_LIMIT)
+                } else {
+                    0.0
+                };
+                sum[c] = sum[c].wrapping_add(fixed::radiance(x));
+            }
+        }
+    }
+
+    /// The mean Stokes vector over `n` kept samples (0 without samples).
+    pub fn mean(&self, n: u32) -> [[f32; 3]; 4] {
+        let n = f64::from(n.max(1));
+        self.0
+            .map(|s| s.map(|v| (fixed::radiance_value(v) / n) as f32))
+    }
+}
+
 /// A `width × height` grid of pixel sums, row-major, top row first.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Film {
@@ -185,6 +216,9 @@ pub struct Film {
     pub height: u32,
     /// The pixels.
     pub pixels: Vec<PixelSums>,
+    /// The Stokes AOVs' sums per pixel when the render measures them (`--stokes`); empty
+    /// otherwise.
+    pub stokes: Vec<StokesSums>,
 }
 
 impl Film {
@@ -194,6 +228,7 @@ impl Film {
             width,
             height,
             pixels: vec![PixelSums::EMPTY; width as usize * height as usize],
+            stokes: Vec::new(),
         }
     }
 
@@ -232,6 +267,31 @@ mod tests {
             rays: 2,
             signed: false,
         }
+    }
+
+    /// The Stokes sums are exact and order-independent like the radiance's, clamp what a
+    /// sample cannot hold and ignore what is not finite.
+    #[test]
+    fn stokes_sums_are_exact_and_bounded() {
+        let mut a = StokesSums::default();
+        let mut b = StokesSums::default();
+        let vals = [0.25, -1.5, 3.0];
+        for v in vals {
+            a.add(&[crate::color::Rgb::splat(v); 4]);
+        }
+        for v in vals.iter().rev() {
+            b.add(&[crate::color::Rgb::splat(*v); 4]);
+        }
+        assert_eq!(a, b);
+        assert_eq!(a.mean(3)[2][1], (0.25 - 1.5 + 3.0) / 3.0);
+        let mut c = StokesSums::default();
+        let mut s = [crate::color::Rgb::ZERO; 4];
+        s[1] = crate::color::Rgb([f32::NAN, f32::INFINITY, 1e30]);
+        c.add(&s);
+        let m = c.mean(1)[1];
+        assert_eq!(m[0], 0.0);
+        assert_eq!(m[1], 0.0);
+        assert_eq!(m[2], fixed::RADIANCE_LIMIT);
     }
 
     #[test]

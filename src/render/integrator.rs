@@ -68,7 +68,8 @@ use super::manifold;
 use super::manifold::{Chain, WalkNumbers, WalkVertex};
 use super::path::{ManifoldVertex, PathSample, PathState, keep_off_the_boundary};
 use super::polarised::{
-    crystal_boundary, crystal_sample, pleochroic_segment, pleochroic_transmittance, polarise,
+    StokesAov, crystal_boundary, crystal_sample, pleochroic_segment, pleochroic_transmittance,
+    polarise, stokes_add,
 };
 use super::shading::shade;
 use super::world::{Hit, LightRef, World};
@@ -87,70 +88,22 @@ pub(crate) const RR_DEPTH: u32 = 3;
 /// The probability that a path at a fluorescent base takes the fluorescent lobe (module docs).
 const FLUORESCENT_SHARE: f32 = 0.5;
 
-/// Traces one camera path carrying transported light `S` (`trace::<RgbSample>` for the RGB
-/// variant).
-///
-/// # Arguments
-/// * `world` – the scene.
-/// * `ray` – the camera ray (unit direction).
-/// * `sampler` – positioned after the camera's slots.
-/// * `max_depth` – most scattering events.
-/// * `strategy` – direct-light estimators.
-pub fn trace<S: Spectral>(
-    world: &World,
-    ray: Ray,
-    sampler: &mut PixelSampler,
-    max_depth: u32,
-    strategy: Strategy,
-) -> PathSample
-where
-    Bsdf: Scatter<S>,
-{
-    let lambda = if S::WAVELENGTH_DIMENSIONS > 0 {
-        S::sample_wavelengths_with(sampler.get2d_at(slots::WAVELENGTH), &world.lines)
-    } else {
-        S::sample_wavelengths(0.0)
-    };
-    trace_at::<S>(world, ray, sampler, max_depth, strategy, lambda).0
-}
-
-/// [`trace`] at given wavelengths: the film sample and the path's estimate at each wavelength
-/// (for tests that hold the wavelengths fixed, e.g. a furnace at every wavelength). After a
-/// dispersive refraction only channel 0 (the hero) of the estimate is meaningful.
-///
-/// # Arguments
-/// As [`trace`], and `lambda` – the wavelengths the path carries.
-pub fn trace_at<S: Spectral>(
-    world: &World,
-    ray: Ray,
-    sampler: &mut PixelSampler,
-    max_depth: u32,
-    strategy: Strategy,
-    lambda: S::Wavelengths,
-) -> (PathSample, S)
-where
-    Bsdf: Scatter<S>,
-{
-    // Polarised transport is its own monomorphised loop, as the variants are: a scene without
-    // it runs code in which the Stokes row does not occur.
-    if world.polarised {
-        trace_path::<S, true>(world, ray, sampler, max_depth, strategy, lambda)
-    } else {
-        trace_path::<S, false>(world, ray, sampler, max_depth, strategy, lambda)
-    }
-}
-
 /// The path loop; with `POL` the path carries its sensor's Stokes row
 /// ([`crate::polarisation::transport`]): a camera analyser starts it, smooth dielectric
 /// boundaries act by Fresnel's Mueller matrices, every other vertex depolarises, and a polarised
-/// light's emission is measured by the row.
-fn trace_path<S: Spectral, const POL: bool>(
+/// light's emission is measured by the row. `analyser` is the camera's (the world's, or a
+/// dichroscope's right window's). With `STOKES` (polarised only) the path also measures the
+/// Stokes vector of its light ([`crate::polarisation::stokes`]) into `stokes`.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn trace_path<S: Spectral, const POL: bool, const STOKES: bool>(
     world: &World,
     mut ray: Ray,
     sampler: &mut PixelSampler,
     max_depth: u32,
     strategy: Strategy,
     lambda: S::Wavelengths,
+    analyser: Option<Vec3>,
+    stokes: &mut [Rgb; 4],
 ) -> (PathSample, S)
 where
     Bsdf: Scatter<S>,
@@ -164,7 +117,12 @@ where
     }
     let mut path = PathState::<S>::new(lambda, ray.medium);
     let mut pol = PathPolarisation::UNPOLARISED;
-    if let Some(axis) = world.analyser {
+    // The Stokes AOVs' rows (polarised transport with `--stokes`).
+    let mut aov: Option<StokesAov<S>> = None;
+    if POL && STOKES {
+        aov = StokesAov::new(world, ray.dir);
+    }
+    if let Some(axis) = analyser {
         if POL {
             pol = PathPolarisation::analyser(axis, ray.dir);
         }
@@ -222,6 +180,9 @@ where
                     if let Some((c, u)) = pleochroic {
                         path.beta *=
                             pleochroic_transmittance::<S>(c, &mut pol, ray.dir, t, u, &path.lambda);
+                        if STOKES && let Some(a) = &mut aov {
+                            a.rows.follow(&pol);
+                        }
                     }
                     if path.medium_events >= world.medium_depth || !path.alive() {
                         break;
@@ -258,7 +219,10 @@ where
                             let w = manifold_weight(strategy, ml.pdf, f * ml.cross, true);
                             let c = path.throughput() * ml.value * (f * w);
                             if c.is_valid() {
-                                path.gather(c);
+                                let added = path.gather(c);
+                                if STOKES {
+                                    stokes_add(&mut aov, added);
+                                }
                             }
                         }
                         path.manifold = Some(ManifoldVertex {
@@ -272,6 +236,9 @@ where
                     path.scatter_in_medium(ps.pdf, p);
                     if POL {
                         pol.depolarise();
+                        if STOKES && let Some(a) = &mut aov {
+                            a.rows.depolarise();
+                        }
                     }
                     path.platelet = None;
                     if path.depth >= RR_DEPTH {
@@ -291,6 +258,9 @@ where
         {
             path.beta *=
                 pleochroic_transmittance::<S>(c, &mut pol, ray.dir, h.t(), u, &path.lambda);
+            if STOKES && let Some(a) = &mut aov {
+                a.rows.follow(&pol);
+            }
         }
         let hit = match found {
             None => {
@@ -298,15 +268,26 @@ where
                 let w = emission_weight(world, strategy, &path, || {
                     (LightRef::Environment, world.environment.pdf(ray.dir))
                 });
-                path.add_emission(le, w);
+                let added = path.add_emission(le, w);
+                if STOKES {
+                    stokes_add(&mut aov, added);
+                }
                 break;
             }
             Some(Hit::Light { index, t }) => {
-                let mut le = world.areas[index]
+                let le_unpolarised = world.areas[index]
                     .emission::<S>(world.areas[index].emitted(-ray.dir), &path.lambda);
+                let mut le = le_unpolarised;
+                // The Stokes rows' own readings of a polarised light (before they settle).
+                let mut read = None;
                 if POL && let Some(axis) = world.areas[index].polariser() {
                     let k = pol.polarised_emission(axis, -ray.dir);
                     le *= S::from_channels(|c| k[c]);
+                    read = aov
+                        .as_ref()
+                        .filter(|_| STOKES)
+                        .filter(|a| !a.rows.settled)
+                        .map(|a| a.rows.polarised_emission(axis, -ray.dir));
                 }
                 let w = match (path.manifold, &world.manifold) {
                     // The walk's chain of refractions since a vertex where the walk ran.
@@ -317,7 +298,15 @@ where
                     }
                     _ => area_emission_weight(world, strategy, &path, &ray, (index, t)),
                 };
-                path.add_emission(le, w);
+                let added = path.add_emission(le, w);
+                if STOKES && let Some(a) = &mut aov {
+                    match read {
+                        Some(kf) => {
+                            a.add_read(path.gathered(path.throughput() * le_unpolarised * w), kf)
+                        }
+                        None => a.add(added),
+                    }
+                }
                 if path.depth == 0 {
                     out.depth = Some(t);
                 }
@@ -372,9 +361,12 @@ where
         let sees_out = path.medium == MediumId::OUTSIDE || sb.flags().is_transmission();
         let nee = strategy != Strategy::BsdfOnly && !sb.flags().is_specular_only() && sees_out;
         if nee {
-            direct_light(
+            let added = direct_light(
                 world, strategy, &sb, wo_local, u_light, u_point, &mut path, &mut out,
             );
+            if STOKES {
+                stokes_add(&mut aov, added);
+            }
         }
         // Manifold next-event estimation from a platelet (the light it sees through the
         // boundary) or from the floor (the light focused on it through the stone).
@@ -430,7 +422,10 @@ where
             let w = manifold_weight(strategy, ml.pdf, p_bsdf, true);
             let c = path.throughput() * f * ml.value * (wi_local.z.abs() * w);
             if c.is_valid() {
-                path.gather(c);
+                let added = path.gather(c);
+                if STOKES {
+                    stokes_add(&mut aov, added);
+                }
             }
         }
         let walk = start.map(|(_, v, _)| v);
@@ -445,7 +440,8 @@ where
         let sampled = match crystal {
             Some(c) => {
                 let outside = path.medium == MediumId::OUTSIDE;
-                crystal_sample::<S>(c, &mut pol, &sb, wo, outside, &path.lambda, (uc, u.x))
+                let rows = aov.as_mut().filter(|_| STOKES).map(|a| &mut a.rows);
+                crystal_sample::<S>(c, &mut pol, rows, &sb, wo, outside, &path.lambda, (uc, u.x))
             }
             None => sb.sample::<S>(wo_local, uc, u, &path.lambda),
         };
@@ -488,7 +484,8 @@ where
         }
         path.scatter(&bs, sb.p, sb.inside);
         if POL && crystal.is_none() {
-            polarise(&mut pol, &mut path, &sb, &bs, wo, wo_local.z > 0.0);
+            let rows = aov.as_mut().filter(|_| STOKES).map(|a| &mut a.rows);
+            polarise(&mut pol, rows, &mut path, &sb, &bs, wo, wo_local.z > 0.0);
         }
         path.platelet = match hit {
             Hit::Platelet { id, .. } => Some(id),
@@ -531,6 +528,9 @@ where
         };
     } else {
         out.radiance = path.l.to_rgb(&path.film);
+    }
+    if STOKES && let Some(a) = &aov {
+        *stokes = a.finish(&path.film);
     }
     (out, path.l)
 }

@@ -17,6 +17,8 @@ use std::fmt;
 /// of fixed-point sums) and room for the outputs' channels; measured 377 bytes a pixel at
 /// 2048×2048 (peak resident size of a 1-spp render, process included).
 pub const FILM_BYTES_PER_PIXEL: u64 = 2 * std::mem::size_of::<PixelSums>() as u64 + 16;
+/// More film bytes per pixel with the Stokes AOVs (`--stokes`): two [`super::film::StokesSums`].
+pub const STOKES_BYTES_PER_PIXEL: u64 = 2 * std::mem::size_of::<super::film::StokesSums>() as u64;
 /// Environment-map bytes per texel at the peak of its setup: the decoded channels and the RGB
 /// image (12 + 12), then pixels and sampling tables (12 + 4); measured 23.6 at 16384×8192.
 pub const MAP_BYTES_PER_TEXEL: u64 = 28;
@@ -62,7 +64,11 @@ impl MemoryEstimate {
             _ => 0,
         };
         MemoryEstimate {
-            film: pixels.saturating_mul(FILM_BYTES_PER_PIXEL),
+            film: pixels.saturating_mul(if scene.stage.stokes {
+                FILM_BYTES_PER_PIXEL + STOKES_BYTES_PER_PIXEL
+            } else {
+                FILM_BYTES_PER_PIXEL
+            }),
             materials: used.saturating_mul(MATERIAL_BYTES),
             environment,
             mesh,

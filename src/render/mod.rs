@@ -15,6 +15,7 @@
 //! reports.
 
 pub mod camera;
+pub mod camera_path;
 pub mod direct;
 pub mod film;
 pub mod filter;
@@ -34,10 +35,10 @@ pub mod study;
 pub mod world;
 
 pub use camera::CameraRays;
+pub use camera_path::{trace, trace_at, trace_with};
 pub use direct::Strategy;
 pub use film::{Film, PixelSums};
 pub use filter::FilterSampler;
-pub use integrator::{trace, trace_at};
 pub use output::{Metadata, exr_image, film_channels};
 pub use path::{PathSample, PathState};
 pub use shading::{ShadingContext, SurfaceBsdf};
@@ -223,7 +224,14 @@ where
 {
     let (w, h) = (settings.width, settings.height);
     let mut film = Film::new(w, h);
-    let rays = CameraRays::new(camera, w, h, depth_of_field);
+    let stokes = world.stokes.is_some();
+    if stokes {
+        film.stokes = vec![film::StokesSums::default(); film.pixels.len()];
+    }
+    // A dichroscope's image is two views side by side, each the camera's whole view: the rays
+    // of a half-width image, the right half's pixels shifted onto it.
+    let half = world.dichroscope.map(|_| (w / 2).max(1));
+    let rays = CameraRays::new(camera, half.unwrap_or(w), h, depth_of_field);
     let filter = FilterSampler::new(settings.filter);
     let tiles: Vec<(u32, u32)> = (0..h.div_ceil(TILE))
         .flat_map(|ty| (0..w.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE)))
@@ -255,7 +263,8 @@ where
     let mut partial = false;
     while done < last {
         let end = (done + step).min(last);
-        let results: Vec<Option<Vec<PixelSums>>> = tiles
+        type TileSums = (Vec<PixelSums>, Vec<film::StokesSums>);
+        let results: Vec<Option<TileSums>> = tiles
             .par_iter()
             .map(|&(x0, y0)| {
                 if stop() {
@@ -263,6 +272,7 @@ where
                 }
                 let (x1, y1) = ((x0 + TILE).min(w), (y0 + TILE).min(h));
                 let mut sums = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
+                let mut stokes_sums = Vec::new();
                 for y in y0..y1 {
                     let row = &film.pixels[(y * w + x0) as usize..(y * w + x1) as usize];
                     match &lane_setup {
@@ -272,6 +282,11 @@ where
                         None => {
                             for (x, &pixel_sums) in (x0..x1).zip(row) {
                                 let mut p = pixel_sums;
+                                let mut ps = film.stokes.get((y * w + x) as usize).copied();
+                                // A dichroscope's right window: the same view, the other analyser.
+                                let right = half.filter(|&h| x >= h);
+                                let column = x - right.unwrap_or(0);
+                                let plain = half.is_none() && ps.is_none();
                                 let pixel = u64::from(y) * u64::from(w) + u64::from(x);
                                 let mut sampler =
                                     PixelSampler::new(settings.sampler, settings.seed, pixel, done);
@@ -280,18 +295,37 @@ where
                                     let offset = filter.sample(sampler.get2d());
                                     let lens = sampler.get2d();
                                     let film_pt =
-                                        Vec2::new(x as f32 + 0.5, y as f32 + 0.5) + offset;
+                                        Vec2::new(column as f32 + 0.5, y as f32 + 0.5) + offset;
                                     let ray = rays.ray(film_pt, lens);
-                                    let sample = trace::<S>(
+                                    let (depth, strategy) = (settings.max_depth, control.strategy);
+                                    if plain {
+                                        p.add(&trace::<S>(
+                                            world,
+                                            ray,
+                                            &mut sampler,
+                                            depth,
+                                            strategy,
+                                        ));
+                                        continue;
+                                    }
+                                    let mut st = [crate::color::Rgb::ZERO; 4];
+                                    let sample = trace_with::<S>(
                                         world,
                                         ray,
                                         &mut sampler,
-                                        settings.max_depth,
-                                        control.strategy,
+                                        depth,
+                                        strategy,
+                                        right.is_some(),
+                                        ps.is_some().then_some(&mut st),
                                     );
-                                    p.add(&sample);
+                                    if p.add(&sample)
+                                        && let Some(ps) = &mut ps
+                                    {
+                                        ps.add(&st);
+                                    }
                                 }
                                 sums.push(p);
+                                stokes_sums.extend(ps);
                             }
                         }
                     }
@@ -299,7 +333,7 @@ where
                 if let Some(progress) = control.progress {
                     progress(sums.len() as u64 * u64::from(end - done));
                 }
-                Some(sums)
+                Some((sums, stokes_sums))
             })
             .collect();
         // A part (a sample range) must hold exactly the samples its range says: a pass stopped
@@ -310,16 +344,21 @@ where
             break;
         }
         for (&(x0, y0), sums) in tiles.iter().zip(results) {
-            let Some(sums) = sums else {
+            let Some((sums, stokes_sums)) = sums else {
                 partial = true;
                 continue;
             };
             let x1 = (x0 + TILE).min(w);
             let mut it = sums.into_iter();
+            let mut st = stokes_sums.into_iter();
             for y in y0..(y0 + TILE).min(h) {
                 for x in x0..x1 {
+                    let i = (y * w + x) as usize;
                     if let Some(p) = it.next() {
-                        film.pixels[(y * w + x) as usize] = p;
+                        film.pixels[i] = p;
+                    }
+                    if let Some(p) = st.next() {
+                        film.stokes[i] = p;
                     }
                 }
             }

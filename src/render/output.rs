@@ -11,6 +11,7 @@
 //! | `variance.R/G/B` | variance of the pixel mean (sample variance / n), for z-tests against references |
 //! | `samples.Y` | samples kept in the pixel (fewer than `spp` in a partial render or where samples were dropped) |
 //! | `material.Y` | material index of the pixel's first sample (see `lapidary.materials`); −1 floor, −2 nothing |
+//! | `S0.R/G/B` … `S3.R/G/B` | with `--stokes` only: the mean Stokes vector of the light reaching the camera before any analyser, linear Rec.709 per component, in the image's frame (`S1` horizontal − vertical, `S2` +45° − −45° from right toward up, `S3` right − left circular; [`crate::polarisation::stokes`]) |
 //!
 //! Attributes (text): `lapidary.version`, `lapidary.recipe`, `lapidary.recipe_hash` (16 hex
 //! digits), `lapidary.seed`, `lapidary.spp` (requested), `lapidary.spp_complete`,
@@ -142,5 +143,20 @@ pub fn film_channels(film: &super::Film) -> Vec<Channel> {
             p.material as f32
         }
     }));
+    if film.stokes.len() == px.len() {
+        for k in 0..4 {
+            for (c, name) in ["R", "G", "B"].iter().enumerate() {
+                channels.push(Channel {
+                    name: format!("S{k}.{name}"),
+                    data: film
+                        .stokes
+                        .iter()
+                        .zip(px)
+                        .map(|(s, p)| s.mean(p.n)[k][c])
+                        .collect(),
+                });
+            }
+        }
+    }
     channels
 }

@@ -171,19 +171,29 @@ impl<S: Spectral> PathState<S> {
         }
     }
 
-    /// Adds emitted radiance `le` reaching the path with MIS weight `w`.
+    /// Adds emitted radiance `le` reaching the path with MIS weight `w`; returns what was added
+    /// (as [`PathState::gather`]).
     #[inline]
-    pub fn add_emission(&mut self, le: S, w: f32) {
-        self.gather(self.throughput() * le * w);
+    pub fn add_emission(&mut self, le: S, w: f32) -> S {
+        self.gather(self.throughput() * le * w)
     }
 
     /// Adds a contribution `c` (throughput × radiance, in the channels the path carries) to the
-    /// radiance, through the fluorescent remap if the path has one.
+    /// radiance, through the fluorescent remap if the path has one; returns what was added (the
+    /// Stokes AOVs weigh it by their rows, [`crate::polarisation::stokes`]).
     #[inline]
-    pub fn gather(&mut self, c: S) {
+    pub fn gather(&mut self, c: S) -> S {
+        let added = self.gathered(c);
+        self.l += added;
+        added
+    }
+
+    /// What [`PathState::gather`] would add for `c`, without adding it.
+    #[inline]
+    pub fn gathered(&self, c: S) -> S {
         match &self.remap {
-            None => self.l += c,
-            Some(m) => self.l += c.remix(m),
+            None => c,
+            Some(m) => c.remix(m),
         }
     }
 

@@ -5,15 +5,80 @@ use super::path::PathState;
 use super::shading::SurfaceBsdf;
 use super::world::CrystalOptics;
 use crate::bsdf::{Bsdf, BsdfSample, Lobe, LobeKind, Scatter};
+use crate::color::Rgb;
 use crate::polarisation::boundary::{Boundary, Mode};
 use crate::polarisation::crystal;
-use crate::polarisation::transport::PathPolarisation;
+use crate::polarisation::stokes::{ROWS, StokesRows};
+use crate::polarisation::transport::{InterfaceEvent, MAX_CHANNELS, PathPolarisation};
 use crate::polarisation::uniaxial::Uniaxial;
 use crate::spectrum::Spectral;
 use glam::Vec3;
 
+/// The Stokes AOVs of a camera path ([`crate::polarisation::stokes`]): its four rows and what
+/// each has measured so far, in the path's channels.
+pub(super) struct StokesAov<S> {
+    /// The rows.
+    pub rows: StokesRows,
+    sum: [S; ROWS],
+}
+
+impl<S: Spectral> StokesAov<S> {
+    /// The rows of a camera ray along `dir` (unit) in a world that measures the Stokes AOVs.
+    pub fn new(world: &super::world::World, dir: Vec3) -> Option<StokesAov<S>> {
+        let right = world.stokes?;
+        let scale = if world.analyser.is_some() {
+            1.0 / crate::polarisation::transport::ANALYSER_TRANSMITTANCE
+        } else {
+            1.0
+        };
+        Some(StokesAov {
+            rows: StokesRows::new(right, dir, scale),
+            sum: [S::ZERO; ROWS],
+        })
+    }
+
+    /// Records a contribution `added` to the path's radiance: each row reads it times its factor.
+    #[inline]
+    pub fn add(&mut self, added: S) {
+        for (sum, f) in self.sum.iter_mut().zip(&self.rows.f) {
+            *sum += added * S::from_channels(|c| f[c]);
+        }
+    }
+
+    /// Records an emission that the rows read with their own corrections `kf` (a polarised
+    /// light: [`StokesRows::polarised_emission`]); `c` is the contribution before any row's
+    /// correction, as [`PathState::gathered`] gives it.
+    pub fn add_read(&mut self, c: S, kf: [[f32; MAX_CHANNELS]; ROWS]) {
+        for (sum, k) in self.sum.iter_mut().zip(&kf) {
+            *sum += c * S::from_channels(|ch| k[ch]);
+        }
+    }
+
+    /// The Stokes vector the path measured, linear Rec.709 per component.
+    pub fn finish(&self, film: &S::Wavelengths) -> [Rgb; 4] {
+        let m = self.sum.map(|s| s.to_rgb(film));
+        // S₀ = R₀, Sⱼ = Rⱼ − R₀ ([`StokesRows::components`]) per colour channel.
+        std::array::from_fn(|j| {
+            if j == 0 {
+                m[0]
+            } else {
+                Rgb(std::array::from_fn(|c| m[j][c] - m[0][c]))
+            }
+        })
+    }
+}
+
+/// [`StokesAov::add`] when the path has the AOVs.
+#[inline]
+pub(super) fn stokes_add<S: Spectral>(aov: &mut Option<StokesAov<S>>, added: S) {
+    if let Some(a) = aov {
+        a.add(added);
+    }
+}
+
 /// The Stokes row's update at a BSDF-sampled vertex: Fresnel's Mueller matrix at a smooth
-/// dielectric interface (the throughput corrected per channel), depolarisation anywhere else.
+/// dielectric interface (the throughput corrected per channel), depolarisation anywhere else;
+/// the Stokes AOVs' rows alike.
 ///
 /// # Arguments
 /// * `wo` – the direction the light leaves toward the previous vertex (world, unit).
@@ -21,6 +86,7 @@ use glam::Vec3;
 #[inline]
 pub(super) fn polarise<S: Spectral>(
     pol: &mut PathPolarisation,
+    rows: Option<&mut StokesRows>,
     path: &mut PathState<S>,
     sb: &SurfaceBsdf<'_>,
     bs: &BsdfSample<S>,
@@ -29,9 +95,12 @@ pub(super) fn polarise<S: Spectral>(
 ) where
     Bsdf: Scatter<S>,
 {
-    use crate::polarisation::transport::{Interface, MAX_CHANNELS};
+    use crate::polarisation::transport::Interface;
     if !bs.flags.is_specular() || sb.interface_eta::<S>(0, &path.lambda).is_none() {
         pol.depolarise();
+        if let Some(r) = rows {
+            r.depolarise();
+        }
         return;
     }
     let refraction = bs.flags.is_transmission();
@@ -49,22 +118,29 @@ pub(super) fn polarise<S: Spectral>(
     } else {
         Interface::Reflection
     };
-    let k = pol.interface(sb.frame.n, wo, bs.wi, eta, kind);
+    let event = InterfaceEvent::new(sb.frame.n, wo, bs.wi, eta, kind, pol.x);
+    let k = pol.take(&event);
+    if let Some(r) = rows {
+        r.take(&event, k);
+    }
     path.beta *= S::from_channels(|c| k[c]);
 }
 
 /// The BSDF sample of a camera path meeting a doubly refractive body's smooth boundary
 /// ([`crate::polarisation::crystal`]): the boundary solved at the wavelength of channel 0 (a
 /// spectral path keeps only its hero from here, as after a dispersive refraction), the row `pol`
-/// updated (every channel alike).
+/// updated (every channel alike), and the Stokes AOVs' `rows` with it (the same choice, each
+/// row's own weight).
 ///
 /// # Arguments
 /// * `wo` – the direction toward the previous vertex (world, unit).
 /// * `outside` – whether the path arrives from outside the stone.
 /// * `u` – two numbers in `[0, 1)`.
+#[allow(clippy::too_many_arguments)]
 pub(super) fn crystal_sample<S: Spectral>(
     crystal: &CrystalOptics,
     pol: &mut PathPolarisation,
+    rows: Option<&mut StokesRows>,
     sb: &SurfaceBsdf<'_>,
     wo: Vec3,
     outside: bool,
@@ -94,7 +170,29 @@ where
     } else {
         crystal::from_inside(&b, -wo, pol, (f64::from(u.0), f64::from(u.1)))?
     };
-    pol.w = [pol.w[0]; crate::polarisation::transport::MAX_CHANNELS];
+    pol.w = [pol.w[0]; MAX_CHANNELS];
+    if let Some(r) = rows
+        && !r.settled
+    {
+        if outside {
+            // The same number picks the same wave for every row (the shares are the adjoint's);
+            // each row's weight is its own.
+            for j in 0..ROWS {
+                let w = crystal::from_outside(&b, wo, &mut r.rows[j], f64::from(u.0))
+                    .map_or(0.0, |s| s.weight);
+                r.rows[j].w = [r.rows[j].w[0]; MAX_CHANNELS];
+                let ratio = if step.weight > 0.0 {
+                    (w / step.weight) as f32
+                } else {
+                    0.0
+                };
+                r.rescale(j, [ratio; MAX_CHANNELS], [1.0; MAX_CHANNELS]);
+            }
+        } else {
+            // Inside, every row is the path's wave's pure state: they step alike.
+            r.follow(pol);
+        }
+    }
     let wi = step.wi.as_vec3().try_normalize()?;
     let kind = if step.crossed {
         LobeKind::SpecularTransmission

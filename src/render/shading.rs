@@ -258,6 +258,7 @@ pub fn shade<'a, W: Copy>(
 impl World {
     /// The BSDF at a hit described by `ctx`, for the incoming direction `wo` (world, toward the
     /// viewer); `None` when the material is unused or there is no floor.
+    #[inline]
     pub fn bsdf_at<W>(&self, ctx: &ShadingContext<W>, wo: Vec3) -> Option<SurfaceBsdf<'_>> {
         let (bxdf, frame, inside, faceted) = match ctx.material {
             Some(m) => {

@@ -131,6 +131,13 @@ pub struct World {
     /// The camera's analyser, an ideal linear polariser: its transmission axis (world, unit, in
     /// the image plane). It passes half of unpolarised light, polarised transport or not.
     pub analyser: Option<Vec3>,
+    /// The image's right (world, unit) when the render measures the Stokes AOVs (polarised
+    /// transport only; [`crate::polarisation::stokes`]).
+    pub stokes: Option<Vec3>,
+    /// A dichroscope's right window ([`crate::scene::Stage::dichroscope`]): the analyser axis of
+    /// the image's right half (world, unit), 90° from [`World::analyser`], which the left half
+    /// keeps. Each half shows the whole view.
+    pub dichroscope: Option<Vec3>,
     /// A doubly refractive body's optics, in polarised transport (otherwise the body is
     /// isotropic with its ordinary index).
     pub crystal: Option<CrystalOptics>,
@@ -297,6 +304,11 @@ impl World {
             bounds,
             polarised,
             analyser: stage.analyser.map(|a| analyser_axis(&stage.camera, a)),
+            stokes: (polarised && stage.stokes).then_some(stage.camera.right),
+            dichroscope: stage
+                .analyser
+                .filter(|_| stage.dichroscope)
+                .map(|a| analyser_axis(&stage.camera, a + std::f32::consts::FRAC_PI_2)),
             crystal,
         })
     }

@@ -120,7 +120,8 @@ impl Effect {
             Effect::DepthOfField => "a perspective camera with aperture > 0",
             Effect::EnvironmentImportance => "an environment Map (EXR)",
             Effect::Polarisation => {
-                "a light with a `polariser`, a stage `analyser` (the `Polariscope` preset), or \
+                "a light with a `polariser`, a stage `analyser` (the `Polariscope` and \
+                 `Dichroscope` presets), a doubly refractive `body.crystal`, `--stokes`, or \
                  `--polarised`"
             }
             Effect::LightPrefilter => {

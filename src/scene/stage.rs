@@ -229,6 +229,14 @@ pub struct Stage {
     /// An ideal linear polariser in front of the camera (an analyser): its transmission axis in
     /// radians from the image's right toward its up; `None` for none.
     pub analyser: Option<f32>,
+    /// Whether the render also measures the Stokes vector of the light reaching the camera (the
+    /// `S0`–`S3` AOVs, `--stokes`; [`crate::polarisation::stokes`]). Needs polarised transport.
+    pub stokes: bool,
+    /// The dichroscope's split image (the `Dichroscope` preset): the left half of the image sees
+    /// the whole view through [`Stage::analyser`], the right half the same view through an
+    /// analyser turned 90° from it — the two polarisations side by side, as a calcite
+    /// dichroscope's two windows show them.
+    pub dichroscope: bool,
 }
 
 /// A rectangular soft box at `center` facing `target`, `w × h`, its `w` edge horizontal.
@@ -392,6 +400,8 @@ impl Stage {
                 seed: 0,
             },
             analyser: None,
+            stokes: false,
+            dichroscope: false,
         }
     }
 
@@ -428,6 +438,24 @@ impl Stage {
             }),
             ..Stage::studio()
         }
+    }
+
+    /// The dichroscope: the polariscope's dark room, camera and light box with the light box's
+    /// polariser taken away (the stone is lit by unpolarised light), and the camera's image split
+    /// in two ([`Stage::dichroscope`]): the left half through an analyser along the image's right
+    /// (the world `x` axis), the right half through one along its up. A pleochroic stone shows
+    /// a different colour in each half wherever its two waves absorb differently; an isotropic
+    /// one the same in both. The image is twice as wide as it is high, each half square.
+    pub fn dichroscope() -> Stage {
+        let mut stage = Stage::polariscope(false);
+        for l in &mut stage.lights {
+            l.polariser = None;
+        }
+        stage.analyser = Some(0.0);
+        stage.dichroscope = true;
+        stage.render.width = 640;
+        stage.render.height = 320;
+        stage
     }
 }
 

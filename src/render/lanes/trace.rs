@@ -1,6 +1,6 @@
 //! The lane path loop: a packet of camera paths traced bounce by bounce in phases
 //! (docs/design.md §13). Every lane runs the scalar integrator's steps
-//! ([`crate::render::integrator::trace_at`]) for an opaque RGB scene in the same order on its own
+//! ([`crate::render::camera_path::trace_at`]) for an opaque RGB scene in the same order on its own
 //! numbers, so each lane's sample is bit for bit the scalar one.
 
 use super::draws::{Draws, bounce_draws, leading_field};

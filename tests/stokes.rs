@@ -1,0 +1,288 @@
+//! The Stokes AOVs (`lapidary render --stokes`, [`lapidary::polarisation::stokes`]) against
+//! closed forms and against the analyser they replace:
+//!
+//! - **A polarised light box seen directly**: `S = ½ L (1, cos 2ψ, sin 2ψ, 0)`, `ψ` the
+//!   polariser's axis in the image's frame (right, up), written here from the recipe's documented
+//!   conventions — exact per pixel, with and without an analyser in front of the camera (the
+//!   Stokes vector is measured before it).
+//! - **Fresnel reflection**: a black glass slab reflecting a white sky at θ: `S1 / S0 =
+//!   (R_s − R_p) / (R_s + R_p)` (s is the image's horizontal), `S2 = S3 = 0` — exact, not only
+//!   within noise: every path's rows see the same reflection, so the ratio holds per path.
+//! - **The analyser it replaces**: a glass sphere in the polariscope rendered once with the
+//!   Stokes AOVs and once behind analysers at α: `I(α) = ½ (S0 + S1 cos 2α + S2 sin 2α)` per
+//!   pixel to rounding. The paths are the same (same seed; a depth limit below Russian
+//!   roulette's, whose survival would otherwise see the analyser's halving).
+//! - **Nothing else changes**: `S0` equals the colour bit for bit where there is no analyser, and
+//!   the AOVs are the same for any thread count (a crystal in the path included).
+
+use lapidary::recipe::GemRecipe;
+use lapidary::render::{Control, Film, World, render_scene};
+use lapidary::scene::{Accuracy, Effect, Scene};
+
+fn compile(text: &str) -> Scene {
+    GemRecipe::parse("stokes.ron", text)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .compile()
+        .unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// `scene` measuring the Stokes AOVs (as `--stokes`: polarised transport forced on).
+fn with_stokes(scene: &Scene) -> Scene {
+    let mut acc = Accuracy::default();
+    acc.force(Effect::Polarisation, true);
+    let mut s = scene.clone();
+    s.set_accuracy(&acc, "--stokes").expect("knob applies");
+    s.stage.stokes = true;
+    s
+}
+
+fn film(scene: &Scene, threads: Option<usize>) -> Film {
+    let world = World::new(scene).expect("world");
+    let control = Control {
+        threads,
+        ..Control::default()
+    };
+    render_scene(&world, scene, &control).film
+}
+
+/// Per pixel, the mean Stokes vector's channel 0.
+fn stokes0(f: &Film) -> Vec<[f64; 4]> {
+    assert_eq!(
+        f.stokes.len(),
+        f.pixels.len(),
+        "the film has the Stokes sums"
+    );
+    f.stokes
+        .iter()
+        .zip(&f.pixels)
+        .map(|(s, p)| s.mean(p.n).map(|c| f64::from(c[0])))
+        .collect()
+}
+
+#[test]
+fn a_polarised_light_box_reads_its_polariser() {
+    for polariser in [0.0f32, 30.0, 75.0, 120.0] {
+        for analyser in [None, Some(20.0f32)] {
+            let a = analyser.map_or(String::new(), |a| format!("analyser: {a},"));
+            let s = with_stokes(&compile(&format!(
+                r#"(materials: {{}}, body: (ior: 1.5), surface: Body,
+                    stage: (shape: Sphere(radius: 0.1), transform: (translate: (40.0, 0.0, 0.0)),
+                            ground: Off, environment: Constant(Gray(0.0)),
+                            lights: [Rect(center: (0.0, -1.0, 0.0), target: (0.0, 0.0, 0.0),
+                                          size: (20.0, 20.0), radiance: Gray(1.0),
+                                          polariser: {polariser})],
+                            camera: Orthographic(from: (0.0, 5.0, 0.0), to: (0.0, 0.0, 0.0),
+                                                 up: (0.0, 0.0, -1.0), height: 1.0),
+                            {a}
+                            render: (width: 8, height: 8, spp: 4)))"#
+            )));
+            // The light faces +y: its axis turns from n × x = −z toward −x; the camera looks
+            // down with right +x and up −z (the conventions of tests/polarisation.rs).
+            let p = f64::from(polariser).to_radians();
+            let axis = [-p.sin(), -p.cos()]; // (x, z)
+            let (c, sn) = (axis[0], -axis[1]); // along right, along up
+            let psi = sn.atan2(c);
+            let want = [0.5, 0.5 * (2.0 * psi).cos(), 0.5 * (2.0 * psi).sin(), 0.0];
+            let f = film(&s, None);
+            for px in stokes0(&f) {
+                for k in 0..4 {
+                    assert!(
+                        (px[k] - want[k]).abs() < 1e-4,
+                        "polariser {polariser}°, analyser {analyser:?}: S{k} {} vs {}",
+                        px[k],
+                        want[k]
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn fresnel_reflection_polarises_across_the_plane_of_incidence() {
+    let n = 1.5f64;
+    for theta in [30.0, n.atan().to_degrees(), 70.0] {
+        let t = f64::to_radians(theta);
+        let (y, z) = (5.0 * t.cos(), 5.0 * t.sin());
+        let s = with_stokes(&compile(&format!(
+            r#"(materials: {{}}, surface: Body,
+                body: (ior: 1.5, medium: (absorption: (10000.0, 10000.0, 10000.0))),
+                stage: (shape: Slab(size: (40.0, 1.0, 40.0)), transform: (translate: (0.0, -0.5, 0.0)),
+                        ground: Off, environment: Constant(Gray(1.0)), lights: [],
+                        camera: Orthographic(from: (0.0, {y}, {z}), to: (0.0, 0.0, 0.0), height: 0.5),
+                        render: (width: 16, height: 16, spp: 16, max_depth: 4, seed: 3)))"#
+        )));
+        let cos_i = t.cos();
+        let sin_t = (1.0 - cos_i * cos_i).sqrt() / n;
+        let cos_t = (1.0 - sin_t * sin_t).sqrt();
+        let rs = ((cos_i - n * cos_t) / (cos_i + n * cos_t)).powi(2);
+        let rp = ((n * cos_i - cos_t) / (n * cos_i + cos_t)).powi(2);
+        let f = film(&s, None);
+        let sum = stokes0(&f).iter().fold([0.0; 4], |mut a, px| {
+            for k in 0..4 {
+                a[k] += px[k];
+            }
+            a
+        });
+        let dop = sum[1] / sum[0];
+        let want = (rs - rp) / (rs + rp);
+        eprintln!("θ {theta:.2}°: S1/S0 {dop:.6} (closed form {want:.6})");
+        assert!(sum[0] > 0.0);
+        assert!((dop - want).abs() < 1e-4, "θ {theta}: {dop} vs {want}");
+        assert!((sum[2] / sum[0]).abs() < 1e-4 && (sum[3] / sum[0]).abs() < 1e-4);
+    }
+}
+
+/// The polariscope's glass sphere without its analyser (the light box still polarised).
+fn sphere(analyser: Option<f32>) -> Scene {
+    let a = analyser.map_or(String::new(), |a| format!("analyser: {a},"));
+    compile(&format!(
+        r#"(materials: {{}}, body: (ior: 1.5), surface: Body,
+            stage: (preset: Polariscope(crossed: true), shape: Sphere(radius: 0.8),
+                    transform: (translate: (0.0, 0.802, 0.0)), {a}
+                    render: (width: 24, height: 24, spp: 8, max_depth: 3, seed: 5)))"#
+    ))
+}
+
+#[test]
+fn the_stokes_vector_predicts_every_analyser() {
+    // The preset's own analyser is replaced: with none, the Stokes render; then each angle.
+    let mut bare = sphere(None);
+    bare.stage.analyser = None;
+    let st = stokes0(&film(&with_stokes(&bare), None));
+    let mut checked = 0;
+    for alpha in [0.0f32, 45.0, 90.0, 150.0] {
+        let s = sphere(Some(alpha));
+        assert_eq!(s.stage.analyser, Some(alpha.to_radians()));
+        let f = film(&s, None);
+        let a = 2.0 * f64::from(alpha).to_radians();
+        for (px, p) in st.iter().zip(&f.pixels) {
+            let want = 0.5 * (px[0] + px[1] * a.cos() + px[2] * a.sin());
+            let got = f64::from(p.mean()[0]);
+            assert!(
+                (got - want).abs() <= 1e-5 * (1.0 + want.abs()),
+                "analyser {alpha}°: {got} vs ½(S0 + S1 cos 2α + S2 sin 2α) = {want}"
+            );
+            checked += usize::from(want > 1e-3);
+        }
+    }
+    // The sphere turns the light's polarisation: some pixels pass every analyser.
+    assert!(checked > 100, "{checked}");
+}
+
+#[test]
+fn s0_is_the_colour_and_the_aovs_do_not_depend_on_threads() {
+    // A glass sphere in a sky and the dichroic sunstone (a crystal's boundary in the paths).
+    let glass = compile(
+        r#"(materials: {}, body: (ior: 1.5), surface: Body,
+            stage: (shape: Sphere(radius: 1.0), ground: Off,
+                    environment: Constant(Gray(1.0)), lights: [],
+                    camera: Orthographic(from: (0.0, 0.0, 5.0), to: (0.0, 0.0, 0.0), height: 2.4),
+                    render: (width: 16, height: 16, spp: 8, max_depth: 12)))"#,
+    );
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("gems/oregon-sunstone-dichroic.ron");
+    let mut sun = GemRecipe::load(&path).and_then(|r| r.compile()).unwrap();
+    sun.stage.render.width = 24;
+    sun.stage.render.height = 18;
+    sun.stage.render.spp = 4;
+    for (name, scene) in [("glass", glass), ("sunstone", sun)] {
+        let s = with_stokes(&scene);
+        let one = film(&s, Some(1));
+        let two = film(&s, Some(2));
+        assert_eq!(one.stokes, two.stokes, "{name}: thread counts differ");
+        assert_eq!(one.pixels, two.pixels, "{name}: thread counts differ");
+        if s.stage.analyser.is_none() {
+            for (st, p) in one.stokes.iter().zip(&one.pixels) {
+                let s0 = st.mean(p.n)[0];
+                assert_eq!(s0.map(f32::to_bits), p.mean().0.map(f32::to_bits), "{name}");
+            }
+        }
+        // The colour is the render without the AOVs, bit for bit.
+        let mut plain = s.clone();
+        plain.stage.stokes = false;
+        let f = film(&plain, Some(2));
+        assert!(f.stokes.is_empty());
+        assert_eq!(f.pixels, one.pixels, "{name}: the AOVs changed the colour");
+        assert!(
+            one.stokes
+                .iter()
+                .any(|s| s.0[1] != [0; 3] || s.0[2] != [0; 3]),
+            "{name}: some light is polarised"
+        );
+    }
+}
+
+#[path = "common/scratch.rs"]
+mod scratch;
+
+/// `lapidary render --stokes` writes the four AOVs (and only with the flag), and refuses what
+/// cannot measure them, naming the flags.
+#[test]
+fn the_command_line_writes_the_stokes_channels() {
+    use std::process::{Command, Stdio};
+    let dir = scratch::Scratch::new("stokes", "cli");
+    let recipe = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/scenes/polariscope-glass-sphere.ron"
+    );
+    let run = |extra: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_lapidary"))
+            .args([
+                "render", recipe, "--size", "24x24", "--spp", "4", "--no-png",
+            ])
+            .args(["--max-depth", "4"])
+            .args(extra)
+            .current_dir(&dir.0)
+            .stdin(Stdio::null())
+            .output()
+            .expect("binary runs")
+    };
+    let out = run(&["-o", "s.exr", "--stokes", "-q"]);
+    assert!(out.status.success(), "{}", scratch::text(&out.stderr));
+    let img = lapidary::image::read_exr(&dir.path("s.exr")).unwrap();
+    let ch = |n: &str| img.channel(n).unwrap_or_else(|| panic!("no {n}"));
+    for k in 0..4 {
+        for c in ["R", "G", "B"] {
+            let v = ch(&format!("S{k}.{c}"));
+            assert!(v.iter().all(|x| x.is_finite()), "S{k}.{c}");
+        }
+    }
+    // The crossed polars darken the colour; the light before the analyser is bright.
+    let total = |n: &str| ch(n).iter().map(|&x| f64::from(x)).sum::<f64>();
+    assert!(
+        total("S0.G") > 4.0 * total("G"),
+        "{} {}",
+        total("S0.G"),
+        total("G")
+    );
+    // The light box's polariser is along the image's right: S1 ≈ S0 around the sphere.
+    assert!(ch("S1.G")[0] > 0.9 * ch("S0.G")[0] && ch("S0.G")[0] > 0.0);
+
+    let out = run(&["-o", "plain.exr", "-q"]);
+    assert!(out.status.success());
+    let plain = lapidary::image::read_exr(&dir.path("plain.exr")).unwrap();
+    assert!(plain.channel("S0.R").is_none());
+    assert_eq!(
+        plain.channel("G"),
+        img.channel("G"),
+        "the colour is the same"
+    );
+
+    for (args, says) in [
+        (
+            &["--stokes", "--polarised", "off"][..],
+            "--stokes contradicts --polarised off",
+        ),
+        (
+            &["--stokes", "--samples", "0..2"][..],
+            "--stokes with --samples",
+        ),
+    ] {
+        let out = run(&[&["-o", "bad.exr"], args].concat());
+        let err = scratch::text(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{err}");
+        assert!(err.contains(says), "{err}");
+    }
+    assert!(!dir.path("bad.exr").exists());
+}
