@@ -33,11 +33,7 @@ pub fn trace<S: Spectral>(
 where
     Bsdf: Scatter<S>,
 {
-    let lambda = if S::WAVELENGTH_DIMENSIONS > 0 {
-        S::sample_wavelengths_with(sampler.get2d_at(slots::WAVELENGTH), &world.lines)
-    } else {
-        S::sample_wavelengths(0.0)
-    };
+    let lambda = wavelengths::<S>(world, sampler);
     trace_at::<S>(world, ray, sampler, max_depth, strategy, lambda).0
 }
 
@@ -88,11 +84,7 @@ pub fn trace_with<S: Spectral>(
 where
     Bsdf: Scatter<S>,
 {
-    let lambda = if S::WAVELENGTH_DIMENSIONS > 0 {
-        S::sample_wavelengths_with(sampler.get2d_at(slots::WAVELENGTH), &world.lines)
-    } else {
-        S::sample_wavelengths(0.0)
-    };
+    let lambda = wavelengths::<S>(world, sampler);
     let a = if right {
         world.dichroscope.or(world.analyser)
     } else {
@@ -104,5 +96,16 @@ where
         (true, Some(out)) => trace_path::<S, true, true>(world, ray, s, m, strategy, l, a, out).0,
         (true, None) => trace_path::<S, true, false>(world, ray, s, m, strategy, l, a, &mut none).0,
         (false, _) => trace_path::<S, false, false>(world, ray, s, m, strategy, l, a, &mut none).0,
+    }
+}
+
+/// The wavelengths a camera path carries: drawn from the sampler's wavelength slot in a spectral
+/// variant, the RGB variant's fixed channels otherwise.
+#[inline]
+fn wavelengths<S: Spectral>(world: &World, sampler: &mut PixelSampler) -> S::Wavelengths {
+    if S::WAVELENGTH_DIMENSIONS > 0 {
+        S::sample_wavelengths_with(sampler.get2d_at(slots::WAVELENGTH), &world.lines)
+    } else {
+        S::sample_wavelengths(0.0)
     }
 }
