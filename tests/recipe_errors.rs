@@ -214,6 +214,7 @@ fn rows() -> Vec<Row> {
         row("pleochroism_black", (4, 4), &["body.crystal.pleochroism.ordinary", "0 <..= 1"], gem(" body: (ior: 1.544,\n  crystal: Uniaxial(ne: 1.553, axis: (0.0, 1.0, 0.0),\n   pleochroism: (ordinary: Gray(0.0), extraordinary: Gray(0.5), distance: 1.0))),\n surface: Body")),
         row("analyser_400", (4, 13), &["analyser = 400", "-360 ..= 360"], stage("  analyser: 400.0,")),
         row("polariscope_rotation_500", (4, 33), &["rotation = 500", "-360 ..= 360"], stage("  preset: Polariscope(rotation: 500.0),")),
+        row("dichroscope_rotation_minus_720", (4, 33), &["rotation = -720", "-360 ..= 360"], stage("  preset: Dichroscope(rotation: -720.0),")),
         row("polariser_minus_400", (4, 92), &["polariser = -400", "-360 ..= 360"], stage("  lights: [Rect(center: (0.0, 4.0, 0.0), size: (1.0, 1.0), radiance: Gray(1.0), polariser: -400.0)],")),
         row("light_target_is_center", (6, 4), &["stage.lights[1]", "`target` equals `center`"], stage("  lights: [\n   Rect(center: (0.0, 4.0, 0.0), size: (1.0, 1.0), radiance: Gray(1.0)),\n   Disc(center: (1.0, 2.0, 3.0), target: (1.0, 2.0, 3.0), radius: 1.0, radiance: Gray(1.0)),\n  ],")),
     ];
