@@ -27,7 +27,7 @@
 //! emission of a polarised light, where a crossed analyser reads zero while the Stokes vector
 //! does not, is measured per row ([`StokesRows::polarised_emission`]).
 
-use super::transport::{Interface, InterfaceEvent, MAX_CHANNELS, PathPolarisation, turn};
+use super::transport::{InterfaceEvent, MAX_CHANNELS, PathPolarisation, turn};
 use glam::Vec3;
 
 /// Rows carried: `R₀ … R₃` (module docs).
@@ -81,25 +81,9 @@ impl StokesRows {
         }
     }
 
-    /// The interface event the sensor's row went through with corrections `k_sensor`
-    /// ([`PathPolarisation::interface`], same arguments): each row takes it and its factor
-    /// changes by `k_row / k_sensor` (0 where the sensor's channel was extinguished).
-    pub fn interface(
-        &mut self,
-        n: Vec3,
-        wo: Vec3,
-        wi: Vec3,
-        eta: [Option<f32>; MAX_CHANNELS],
-        kind: Interface,
-        k_sensor: [f32; MAX_CHANNELS],
-    ) {
-        if !self.settled {
-            let event = InterfaceEvent::new(n, wo, wi, eta, kind, self.rows[0].x);
-            self.take(&event, k_sensor);
-        }
-    }
-
-    /// [`StokesRows::interface`] for an event already computed (the sensor's).
+    /// The interface event the sensor's row took ([`PathPolarisation::take`]) with corrections
+    /// `k_sensor`: each row takes it too and its factor changes by `k_row / k_sensor` (0 where
+    /// the sensor's channel was extinguished).
     pub fn take(&mut self, event: &InterfaceEvent, k_sensor: [f32; MAX_CHANNELS]) {
         if self.settled {
             return;
@@ -156,6 +140,7 @@ impl StokesRows {
 
 #[cfg(test)]
 mod tests {
+    use super::super::transport::Interface;
     use super::super::{Mueller, Stokes, fresnel};
     use super::*;
 
@@ -188,8 +173,9 @@ mod tests {
             } else {
                 (2.0 * n * n.dot(wo) - wo, Interface::Reflection, eta)
             };
-            let k = sensor.interface(n, wo, wi, [Some(e); 4], kind);
-            rows.interface(n, wo, wi, [Some(e); 4], kind, k);
+            let event = InterfaceEvent::new(n, wo, wi, [Some(e); 4], kind, sensor.x);
+            let k = sensor.take(&event);
+            rows.take(&event, k);
             beta *= f64::from(k[0]);
             let cos = f64::from(wi.dot(n).abs());
             let m = if refract {
@@ -241,14 +227,15 @@ mod tests {
         let mut rows = StokesRows::new(Vec3::X, Vec3::NEG_Z, 2.0);
         rows.depolarise();
         let before = rows;
-        rows.interface(
+        let event = InterfaceEvent::new(
             Vec3::Z,
             Vec3::new(0.6, 0.0, 0.8),
             Vec3::new(-0.6, 0.0, 0.8),
             [Some(1.5); 4],
             Interface::Reflection,
-            [0.7; 4],
+            Vec3::X,
         );
+        rows.take(&event, [0.7; 4]);
         assert_eq!(rows, before);
         assert!(rows.rows.iter().all(PathPolarisation::is_unpolarised));
         assert_eq!(rows.f, [[2.0; MAX_CHANNELS]; ROWS]);

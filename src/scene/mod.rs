@@ -10,6 +10,7 @@ mod apply;
 pub(crate) use apply::stack_calls;
 pub mod body;
 pub mod effects;
+mod presets;
 pub mod stage;
 pub mod surface;
 pub mod view;
