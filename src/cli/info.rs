@@ -193,22 +193,35 @@ pub fn describe(recipe: &GemRecipe, scene: &Scene, points: u32) -> String {
                 law.abbe()
             ),
         };
-        // A doubly refractive body: `ior` is ω.
+        // A doubly refractive body: `ior` is ω or n_α.
         let ior = match &b.crystal {
             None => ior,
-            Some(c) => format!(
-                "ω {ior}, ε {} (uniaxial, axis {:.3?}{})",
-                c.ne,
-                c.axis.to_array(),
-                if c.sigma_o.is_black() && c.sigma_e.is_black() {
-                    String::new()
-                } else {
-                    format!(
-                        "; pleochroic σω {:.3?}, σε {:.3?} per object unit",
-                        c.sigma_o.0, c.sigma_e.0
-                    )
+            Some(c) => {
+                let absorbs = |names: &[&str]| {
+                    if !c.pleochroic() {
+                        return String::new();
+                    }
+                    let parts: Vec<String> = names
+                        .iter()
+                        .zip(&c.sigma)
+                        .map(|(n, s)| format!("σ{n} {:.3?}", s.0))
+                        .collect();
+                    format!("; pleochroic {} per object unit", parts.join(", "))
+                };
+                match c.indices {
+                    crate::scene::body::Indices::Uniaxial { ne, axis } => format!(
+                        "ω {ior}, ε {ne} (uniaxial, axis {:.3?}{})",
+                        axis.to_array(),
+                        absorbs(&["ω", "ε"])
+                    ),
+                    crate::scene::body::Indices::Biaxial { beta, gamma, axes } => format!(
+                        "α {ior}, β {beta}, γ {gamma} (biaxial, X {:.3?}, Z {:.3?}{})",
+                        axes[0].to_array(),
+                        axes[2].to_array(),
+                        absorbs(&["α", "β", "γ"])
+                    ),
                 }
-            ),
+            }
         };
         let _ = writeln!(
             o,

@@ -1,7 +1,10 @@
-//! The boundary between an isotropic medium and a uniaxial crystal: the two reflected and two
-//! transmitted waves of any incident wave, from the continuity of the tangential electric and
-//! magnetic fields (Born & Wolf, *Principles of Optics*, 7th ed., §1.1.3; Yariv & Yeh, *Optical
-//! Waves in Crystals*, 1984, §4.7, whose 4 × 4 boundary problem this solves directly).
+//! The boundary between an isotropic medium and a uniaxial or biaxial crystal: the two reflected
+//! and two transmitted waves of any incident wave, from the continuity of the tangential electric
+//! and magnetic fields (Born & Wolf, *Principles of Optics*, 7th ed., §1.1.3; Yariv & Yeh,
+//! *Optical Waves in Crystals*, 1984, §4.7, whose 4 × 4 boundary problem this solves directly).
+//! A uniaxial crystal's waves have closed forms; a biaxial crystal's normal components are the
+//! roots of a quartic ([`super::biaxial::Biaxial::normal_components`]), sorted by the direction
+//! their energy or their decay takes.
 //!
 //! Units: wave vectors in units of the vacuum wave number (`|k|` is a wave's index), non-magnetic
 //! media, so a plane wave's magnetic field is `H = k × E` and its power flux through the boundary
@@ -12,9 +15,11 @@
 //!
 //! Checked against the Fresnel equations (an index-matched crystal is isotropic), the
 //! normal-incidence reflectance along and across an optic axis in the surface, energy
-//! conservation for random crystals, axes and directions, and reciprocity.
+//! conservation for random crystals, axes and directions, reciprocity, and a biaxial crystal with
+//! two equal indices against the uniaxial closed forms.
 
-use super::uniaxial::Uniaxial;
+use super::biaxial::{self, Biaxial};
+use super::optics::Optics;
 use glam::DVec3;
 use num_complex::Complex64 as C;
 
@@ -59,6 +64,10 @@ pub enum Mode {
     O,
     /// Crystal, extraordinary wave.
     E,
+    /// Biaxial crystal, the fast wave (the index surface's inner sheet, the smaller index).
+    Fast,
+    /// Biaxial crystal, the slow wave (the outer sheet, the larger index).
+    Slow,
 }
 
 /// A plane wave at the boundary.
@@ -119,7 +128,7 @@ pub struct Outgoing {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Boundary {
     /// The crystal.
-    pub crystal: Uniaxial,
+    pub crystal: Optics,
     /// Index of the isotropic medium.
     pub n1: f64,
     /// Unit normal pointing into the isotropic medium.
@@ -137,12 +146,12 @@ pub enum Incident {
         /// `Mode::S` or `Mode::P`.
         mode: Mode,
     },
-    /// From inside the crystal: the wave of `mode` (`O` or `E`) whose wave vector points along
+    /// From inside the crystal: the wave of `mode` (one of the crystal's) whose wave vector points along
     /// the unit `dir` (toward the boundary, `dir · normal > 0`).
     Inside {
         /// Wave-vector direction, unit.
         dir: DVec3,
-        /// `Mode::O` or `Mode::E`.
+        /// One of the crystal's [`Optics::modes`].
         mode: Mode,
     },
 }
@@ -174,8 +183,7 @@ impl Boundary {
 
     /// The crystal's wave of `mode` with tangential `t`, going away from the boundary (down,
     /// decaying into the crystal when evanescent) or toward it (`up`, propagating).
-    fn crystal_wave(&self, t: DVec3, mode: Mode, up: bool, s: DVec3) -> Wave {
-        let x = &self.crystal;
+    fn crystal_wave(&self, x: &super::uniaxial::Uniaxial, t: DVec3, mode: Mode, up: bool, s: DVec3) -> Wave {
         let (n, c) = (self.normal, x.axis);
         let (io, ie) = (1.0 / (x.no * x.no), 1.0 / (x.ne * x.ne));
         // The normal component u of k = t + u n.
@@ -224,29 +232,76 @@ impl Boundary {
     /// power shares; `reference` fixes the s axis at normal incidence. `None` if the problem is
     /// singular (a grazing wave).
     pub fn solve(&self, incident: Incident, reference: DVec3) -> Option<[Outgoing; 4]> {
+        let (t, s, index) = self.tangential(incident, reference);
+        let out = self.outgoing(t, s)?;
+        self.amplitudes(incident, index, t, s, &out)
+    }
+
+    /// [`Boundary::solve`] for an s and a p wave from outside along the unit `dir` (toward the
+    /// crystal), `[s, p]`: the outgoing waves, which depend only on the tangential wave vector,
+    /// found once.
+    pub fn solve_sp(&self, dir: DVec3, reference: DVec3) -> Option<[[Outgoing; 4]; 2]> {
+        let inc = |mode| Incident::Outside { dir, mode };
+        let (t, s, index) = self.tangential(inc(Mode::S), reference);
+        let out = self.outgoing(t, s)?;
+        Some([
+            self.amplitudes(inc(Mode::S), index, t, s, &out)?,
+            self.amplitudes(inc(Mode::P), index, t, s, &out)?,
+        ])
+    }
+
+    /// The tangential wave vector of `incident`, the s axis and the incident wave's index.
+    fn tangential(&self, incident: Incident, reference: DVec3) -> (DVec3, DVec3, f64) {
         let n = self.normal;
-        let (dir, inc_mode) = match incident {
-            Incident::Outside { dir, mode } | Incident::Inside { dir, mode } => (dir, mode),
-        };
         let index = match incident {
             Incident::Outside { .. } => self.n1,
-            Incident::Inside { dir, mode } => match mode {
-                Mode::O => self.crystal.no,
-                _ => self.crystal.extraordinary_index(dir),
-            },
+            Incident::Inside { dir, mode } => self.crystal.index(dir, mode),
+        };
+        let dir = match incident {
+            Incident::Outside { dir, .. } | Incident::Inside { dir, .. } => dir,
         };
         let t = index * (dir - n * dir.dot(n));
-        let s = self.s_axis(t, reference);
-        let inc = match incident {
-            Incident::Outside { .. } => self.isotropic(t, s, inc_mode, false),
-            Incident::Inside { .. } => self.crystal_wave(t, inc_mode, true, s),
+        (t, self.s_axis(t, reference), index)
+    }
+
+    /// The four waves leaving the boundary with tangential `t` (s axis `s`): `S`, `P` on the
+    /// isotropic side, then the crystal's two.
+    fn outgoing(&self, t: DVec3, s: DVec3) -> Option<[Wave; 4]> {
+        let [c0, c1] = match &self.crystal {
+            Optics::Uniaxial(x) => [
+                self.crystal_wave(x, t, Mode::O, false, s),
+                self.crystal_wave(x, t, Mode::E, false, s),
+            ],
+            Optics::Biaxial(x) => self.biaxial_down(x, t, s)?,
         };
-        let out = [
+        Some([
             self.isotropic(t, s, Mode::S, true),
             self.isotropic(t, s, Mode::P, true),
-            self.crystal_wave(t, Mode::O, false, s),
-            self.crystal_wave(t, Mode::E, false, s),
-        ];
+            c0,
+            c1,
+        ])
+    }
+
+    /// The amplitudes and powers of the `out` waves for `incident` (of index `index`).
+    fn amplitudes(
+        &self,
+        incident: Incident,
+        index: f64,
+        t: DVec3,
+        s: DVec3,
+        out: &[Wave; 4],
+    ) -> Option<[Outgoing; 4]> {
+        let n = self.normal;
+        let inc = match (incident, &self.crystal) {
+            (Incident::Outside { mode, .. }, _) => self.isotropic(t, s, mode, false),
+            (Incident::Inside { mode, .. }, Optics::Uniaxial(x)) => {
+                self.crystal_wave(x, t, mode, true, s)
+            }
+            (Incident::Inside { dir, mode }, Optics::Biaxial(x)) => {
+                let k = biaxial::complex(index * dir);
+                Wave::new(mode, k, x.field(k, s, mode == Mode::Slow))
+            }
+        };
         // Tangential E and H continuous: Σ(isotropic side) = Σ(crystal side). Unknowns: the four
         // outgoing amplitudes; the incident wave sits on its own side.
         let t1 = cv(s);
@@ -287,6 +342,63 @@ impl Boundary {
     }
 }
 
+impl Boundary {
+    /// A biaxial crystal's two waves with tangential `t` that leave the boundary into the
+    /// crystal, `[fast, slow]`: of the quartic's four roots, the real ones whose ray goes down
+    /// and the complex ones that decay downward. Two propagating waves are named by their
+    /// indices; beside an evanescent one the propagating wave is the slow one (the line of
+    /// constant `t` misses the inner sheet first); two roots within 1e-6 are one wave along an
+    /// optic axis, given two orthogonal fields. `None` if the roots do not split two and two (a
+    /// wave grazing the boundary).
+    fn biaxial_down(&self, x: &Biaxial, t: DVec3, s: DVec3) -> Option<[Wave; 2]> {
+        let n = self.normal;
+        let roots = x.normal_components(t, n)?;
+        let mut down = [(C::from(0.0), false); 2];
+        let mut count = 0;
+        for u in roots {
+            let real = u.im.abs() <= 1e-9 * (1.0 + u.re.abs());
+            let goes_down = if real {
+                x.ray(t + u.re * n).dot(n) < 0.0
+            } else {
+                u.im < 0.0
+            };
+            if goes_down {
+                if count == 2 {
+                    return None;
+                }
+                down[count] = (if real { C::from(u.re) } else { u }, real);
+                count += 1;
+            }
+        }
+        if count != 2 {
+            return None;
+        }
+        let k = |u: C| add(cv(t), scale(cv(n), u));
+        let index = |u: C| norm(k(u));
+        let [(a, ra), (b, rb)] = down;
+        // Fast first.
+        let (fast, slow) = match (ra, rb) {
+            (true, true) if index(a) > index(b) => (b, a),
+            (true, false) => (b, a),
+            _ => (a, b),
+        };
+        let degenerate = ra && rb && (fast - slow).norm() <= 1e-6 * (1.0 + fast.norm());
+        let (fast, slow) = if degenerate {
+            let mid = 0.5 * (fast + slow);
+            (mid, mid)
+        } else {
+            (fast, slow)
+        };
+        let (kf, ks) = (k(fast), k(slow));
+        let [ef, es] = if degenerate {
+            x.degenerate_fields(kf, s)
+        } else {
+            [x.field(kf, s, false), x.field(ks, s, false)]
+        };
+        Some([Wave::new(Mode::Fast, kf, ef), Wave::new(Mode::Slow, ks, es)])
+    }
+}
+
 /// Gaussian elimination with partial pivoting on an augmented 4 × 5 system.
 fn solve4(mut a: [[C; 5]; 4]) -> Option<[C; 4]> {
     for col in 0..4 {
@@ -313,6 +425,7 @@ fn solve4(mut a: [[C; 5]; 4]) -> Option<[C; 4]> {
 mod tests {
     use super::*;
     use crate::polarisation::fresnel;
+    use crate::polarisation::uniaxial::Uniaxial;
     use crate::sampler::Rng;
 
     fn random_unit(rng: &mut Rng) -> DVec3 {
@@ -324,11 +437,11 @@ mod tests {
 
     fn boundary(no: f64, ne: f64, axis: DVec3) -> Boundary {
         Boundary {
-            crystal: Uniaxial {
+            crystal: Optics::Uniaxial(Uniaxial {
                 no,
                 ne,
                 axis: axis.normalize(),
-            },
+            }),
             n1: 1.0,
             normal: DVec3::Z,
         }
@@ -409,8 +522,7 @@ mod tests {
                 };
                 // An e wave vector whose energy does not reach the boundary is not incident.
                 if mode == Mode::E {
-                    let k = b.crystal.extraordinary_index(d) * d;
-                    if b.crystal.ray(k).z <= 1e-6 {
+                    if b.crystal.ray(d, Mode::E).z <= 1e-6 {
                         continue;
                     }
                 }

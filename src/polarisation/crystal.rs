@@ -1,9 +1,9 @@
-//! A camera path meeting the smooth boundary of a uniaxial crystal ([`super::boundary`]): which
+//! A camera path meeting the smooth boundary of a uniaxial or biaxial crystal ([`super::boundary`]): which
 //! wave the light came from, chosen with its probability, and the path's Stokes row and
 //! throughput after it.
 //!
 //! Inside the crystal light travels as two waves whose energy follows different rays (the
-//! ordinary and the extraordinary); along one ray direction the path carries one of them, in a
+//! ordinary and the extraordinary, or a biaxial crystal's fast and slow); along one ray direction the path carries one of them, in a
 //! pure linear polarisation — its electric field — so inside the crystal the row is
 //! `(1, 1, 0, 0)` in the frame whose axis is that field and the path remembers the wave
 //! ([`super::transport::PathPolarisation::mode`]). Waves are added incoherently, as ray optics
@@ -21,6 +21,7 @@
 //! angle, which this leaves out (an error of order `ρ²`, below 1 % for calcite's 6°).
 
 use super::boundary::{Boundary, Incident, Mode, Outgoing};
+use super::optics::Optics;
 use super::transport::PathPolarisation;
 use glam::DVec3;
 use num_complex::Complex64 as C;
@@ -62,50 +63,15 @@ fn dot4(a: [f64; 4], b: [f64; 4]) -> f64 {
 
 /// The unit ray direction of a crystal wave (its energy), from its wave vector.
 fn ray_of(b: &Boundary, o: &Outgoing) -> DVec3 {
-    let k = o.wave.direction();
-    match o.wave.mode {
-        Mode::E => b.crystal.ray(k * b.crystal.extraordinary_index(k)),
-        _ => k,
-    }
-}
-
-/// The wave-vector direction of the crystal wave of `mode` whose energy travels along the unit
-/// `ray`: `k ∝ n_o² (r·c) c + n_e² (r − (r·c) c)`, inverting [`super::uniaxial::Uniaxial::ray`].
-fn wave_of_ray(b: &Boundary, ray: DVec3, mode: Mode) -> DVec3 {
-    match mode {
-        Mode::E => {
-            let c = b.crystal.axis;
-            let along = ray.dot(c) * c;
-            (b.crystal.no * b.crystal.no * along + b.crystal.ne * b.crystal.ne * (ray - along))
-                .normalize()
-        }
-        _ => ray,
-    }
-}
-
-/// The wave-vector direction of the crystal's wave of `mode` whose energy travels along the unit
-/// `ray` (public form of the inversion of [`super::uniaxial::Uniaxial::ray`]).
-pub fn wave_direction(crystal: &super::uniaxial::Uniaxial, ray: DVec3, mode: Mode) -> DVec3 {
-    let b = Boundary {
-        crystal: *crystal,
-        n1: 1.0,
-        normal: DVec3::Z,
-    };
-    wave_of_ray(&b, ray, mode)
+    b.crystal.ray(o.wave.direction(), o.wave.mode)
 }
 
 /// The row of the pure state of the crystal's wave of `mode` along the unit `ray`: `(1, 1, 0, 0)`
-/// in the frame whose axis is the wave's electric field (across the ray) — across the plane of
-/// ray and axis for the ordinary wave, in it for the extraordinary (Born & Wolf §15.3).
-pub fn pure_state(crystal: &super::uniaxial::Uniaxial, ray: DVec3, mode: Mode) -> PathPolarisation {
-    let c = crystal.axis;
-    let across = ray.cross(c).try_normalize();
-    let x = match (mode, across) {
-        (_, None) => ray.any_orthonormal_vector(),
-        (Mode::O, Some(a)) => a,
-        // In the plane of ray and axis, across the ray.
-        (_, Some(a)) => a.cross(ray).normalize(),
-    };
+/// in the frame whose axis is the wave's electric field (across the ray) — for a uniaxial crystal
+/// across the plane of ray and axis for the ordinary wave, in it for the extraordinary (Born &
+/// Wolf §15.3).
+pub fn pure_state(crystal: &Optics, ray: DVec3, mode: Mode) -> PathPolarisation {
+    let x = crystal.field(ray, mode);
     PathPolarisation {
         x: x.as_vec3(),
         w: [[1.0, 0.0, 0.0]; super::transport::MAX_CHANNELS],
@@ -150,8 +116,7 @@ pub fn from_outside(
     let reference = p.x.as_dvec3();
     let dir = -wo;
     // Adjoint: unpolarised light sent in along the path.
-    let s_in = b.solve(Incident::Outside { dir, mode: Mode::S }, reference)?;
-    let p_in = b.solve(Incident::Outside { dir, mode: Mode::P }, reference)?;
+    let [s_in, p_in] = b.solve_sp(dir, reference)?;
     let share = |j: usize| 0.5 * (s_in[j].power + p_in[j].power);
     let shares = [share(0) + share(1), share(2), share(3)];
     let choice = pick(&shares, u)?;
@@ -164,20 +129,7 @@ pub fn from_outside(
         // Reflection: the physical light arrived along −wi (mirror of wo); its Jones matrix
         // (columns incident s, p) is the solve for that direction, whose s axis is this one.
         let wi = 2.0 * n * n.dot(wo) - wo;
-        let rs = b.solve(
-            Incident::Outside {
-                dir: -wi,
-                mode: Mode::S,
-            },
-            reference,
-        )?;
-        let rp = b.solve(
-            Incident::Outside {
-                dir: -wi,
-                mode: Mode::P,
-            },
-            reference,
-        )?;
+        let [rs, rp] = b.solve_sp(-wi, reference)?;
         let jones = [
             [rs[0].amplitude, rp[0].amplitude],
             [rs[1].amplitude, rp[1].amplitude],
@@ -246,22 +198,20 @@ pub fn from_inside(
     u: (f64, f64),
 ) -> Option<CrystalStep> {
     let reference = p.x.as_dvec3();
+    let modes = b.crystal.modes();
     let mode = match p.mode {
         Some(m) => m,
         // (1, 0, 0, 0) = ½ (1, m_o) + ½ (1, m_e): the two waves along a ray are orthogonal.
-        None if u.0 < 0.5 => Mode::O,
-        None => Mode::E,
+        None if u.0 < 0.5 => modes[0],
+        None => modes[1],
     };
     // The light's wave travels down along −dir; the adjoint sends it back up along dir.
-    let k_up = wave_of_ray(b, dir, mode);
+    let k_up = b.crystal.wave_of_ray(dir, mode);
     let adj = b.solve(Incident::Inside { dir: k_up, mode }, reference)?;
     let shares = [adj[0].power + adj[1].power, adj[2].power, adj[3].power];
     let choice = pick(&shares, u.1)?;
     let prob = shares[choice] / shares.iter().sum::<f64>();
-    let index_own = match mode {
-        Mode::O => b.crystal.no,
-        _ => b.crystal.extraordinary_index(k_up),
-    };
+    let index_own = b.crystal.index(k_up, mode);
     if choice == 0 {
         // In from outside along −wi: the Jones row into this wave, per unit incident power.
         let wi = if adj[0].power >= adj[1].power {
@@ -269,12 +219,8 @@ pub fn from_inside(
         } else {
             adj[1].wave.direction()
         };
-        let sp =
-            [Mode::S, Mode::P].map(|m| b.solve(Incident::Outside { dir: -wi, mode: m }, reference));
-        let [Some(s_in), Some(p_in)] = sp else {
-            return None;
-        };
-        let j = if mode == Mode::O { 2 } else { 3 };
+        let [s_in, p_in] = b.solve_sp(-wi, reference)?;
+        let j = b.crystal.slot(mode);
         let (a, pa) = (s_in[j].amplitude, s_in[j].power);
         let (bb, pb) = (p_in[j].amplitude, p_in[j].power);
         // A common flux factor turns amplitudes into power-normalised ones (s and p carry the
@@ -325,7 +271,7 @@ pub fn from_inside(
         },
         reference,
     )?;
-    let r = phys[if mode == Mode::O { 2 } else { 3 }].power;
+    let r = phys[b.crystal.slot(mode)].power;
     let index_k = DVec3::new(o.wave.k[0].re, o.wave.k[1].re, o.wave.k[2].re).length();
     enter_wave(p, &o, -ray);
     Some(CrystalStep {
@@ -346,11 +292,25 @@ mod tests {
 
     fn calcite(axis: DVec3) -> Boundary {
         Boundary {
-            crystal: Uniaxial {
+            crystal: Optics::Uniaxial(Uniaxial {
                 no: 1.6584,
                 ne: 1.4864,
                 axis: axis.normalize(),
-            },
+            }),
+            n1: 1.0,
+            normal: DVec3::Z,
+        }
+    }
+
+    /// A strongly biaxial crystal (n 1.5, 1.65, 1.72) whose X axis is `axis`.
+    fn strong_biaxial(axis: DVec3) -> Boundary {
+        let x = axis.normalize();
+        let y = x.any_orthonormal_vector();
+        Boundary {
+            crystal: Optics::Biaxial(crate::polarisation::biaxial::Biaxial {
+                n: [1.5, 1.65, 1.72],
+                axes: [x, y, x.cross(y)],
+            }),
             n1: 1.0,
             normal: DVec3::Z,
         }
@@ -361,11 +321,11 @@ mod tests {
     #[test]
     fn isotropic_limit_matches_the_scalar_boundary() {
         let b = Boundary {
-            crystal: Uniaxial {
+            crystal: Optics::Uniaxial(Uniaxial {
                 no: 1.5,
                 ne: 1.5,
                 axis: DVec3::new(0.3, 0.5, 0.8).normalize(),
-            },
+            }),
             n1: 1.0,
             normal: DVec3::Z,
         };
@@ -390,7 +350,8 @@ mod tests {
     }
 
     /// The boundary's choices are drawn with the probabilities the steps report: over 12
-    /// configurations (calcite, random axes and directions, from outside and inside), 30 000
+    /// configurations (calcite and a strongly biaxial crystal in turn, random axes and
+    /// directions, from outside and inside), 30 000
     /// uniform draws each, Pearson's chi-square of the three outcomes' counts against
     /// `prob × draws` stays below its critical value at α 0.01 for the family, Šidák-adjusted
     /// over the 24 tests (4.19e-4 each: 15.55 for two degrees of freedom, 12.46 for one).
@@ -398,13 +359,17 @@ mod tests {
     fn choices_follow_their_probabilities() {
         let mut rng = Rng::new(77);
         let mut tests = 0;
-        for _ in 0..12 {
+        for config in 0..12 {
             let axis = DVec3::new(
                 f64::from(rng.uniform()) - 0.5,
                 f64::from(rng.uniform()) - 0.3,
                 f64::from(rng.uniform()) - 0.5,
             );
-            let b = calcite(axis);
+            let b = if config % 2 == 0 {
+                calcite(axis)
+            } else {
+                strong_biaxial(axis)
+            };
             let z = 0.1 + 0.85 * f64::from(rng.uniform());
             let dir = DVec3::new((1.0 - z * z).sqrt(), 0.0, z);
             for inside in [false, true] {
@@ -414,7 +379,7 @@ mod tests {
                 for _ in 0..n {
                     let mut p = PathPolarisation::UNPOLARISED;
                     let step = if inside {
-                        p.mode = Some(Mode::O);
+                        p.mode = Some(b.crystal.modes()[0]);
                         from_inside(&b, dir, &mut p, (0.0, f64::from(rng.uniform())))
                     } else {
                         from_outside(&b, dir, &mut p, f64::from(rng.uniform()))
@@ -457,7 +422,11 @@ mod tests {
                 f64::from(rng.uniform()) - 0.5,
                 f64::from(rng.uniform()) - 0.5,
             );
-            let b = calcite(axis);
+            let b = if rng.uniform() < 0.5 {
+                calcite(axis)
+            } else {
+                strong_biaxial(axis)
+            };
             let z = 0.05 + 0.95 * f64::from(rng.uniform());
             let phi = std::f64::consts::TAU * f64::from(rng.uniform());
             let r = (1.0 - z * z).sqrt();

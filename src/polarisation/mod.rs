@@ -1,5 +1,5 @@
 //! Polarised light and crystal optics: Stokes vectors, Mueller matrices, the Fresnel matrices of
-//! dielectric and conductor interfaces, refraction into a uniaxial crystal, and the polarised
+//! dielectric and conductor interfaces, refraction into a uniaxial or biaxial crystal, and the polarised
 //! transport the path loop runs when a scene calls for it ([`transport`]: the camera's Stokes
 //! row carried per channel). Tested against closed forms (Malus's law, Brewster's angle, the
 //! retardance of total internal reflection and Fresnel's rhomb, energy balance, the scalar
@@ -22,11 +22,14 @@
 //! - Jones amplitudes use the time dependence `e^{−iωt}` (Born & Wolf); `S3 > 0` is then the
 //!   polarisation whose `y` component lags.
 
+pub mod biaxial;
 pub mod boundary;
 pub mod crystal;
 pub mod fresnel;
 pub mod interference;
 pub mod mueller;
+pub mod optics;
+pub mod quartic;
 pub mod stokes;
 pub mod transport;
 pub mod uniaxial;

@@ -23,6 +23,7 @@
 //! uniform `transform.scale` is applied at compile time, so a scaled stone keeps its look.
 
 use super::color::ColorDesc;
+pub use super::crystal::{CrystalDesc, PleochroismDesc, TrichroismDesc};
 pub use super::dispersion::DispersionDesc;
 use super::platelets::PlateletsDesc;
 use super::ranged::refuse;
@@ -41,8 +42,6 @@ pub const BODY_IOR: (f32, f32) = (1.0001, 4.0);
 
 ranged!(ior_range, "body.ior", 1.0001, 4.0);
 ranged!(distance_range, "medium.distance", open 0.0, 1e4);
-ranged!(ne_range, "crystal.ne", 1.0001, 4.0);
-ranged!(pleochroism_distance, "pleochroism.distance", open 0.0, 1e4);
 ranged!(g_range, "phase g", -0.99, 0.99);
 
 /// A coefficient triple named `what`: finite, 0 ..= 1e4 per object unit.
@@ -193,66 +192,6 @@ pub struct BodyDesc {
     /// rest. Needs a smooth boundary; turns polarised transport on.
     #[serde(default)]
     pub crystal: Option<CrystalDesc>,
-}
-
-/// The optics of a doubly refractive body.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub enum CrystalDesc {
-    /// A uniaxial crystal (quartz, calcite, tourmaline, zircon, corundum, beryl): waves across
-    /// the optic axis polarised along it meet the extraordinary index `ne` (ε), every other
-    /// polarisation the ordinary `ior` (ω).
-    Uniaxial {
-        /// Extraordinary index ε, 1.0001 ..= 4 (with a `dispersion`, at the d line; the
-        /// birefringence ε − ω is kept at every wavelength).
-        #[serde(deserialize_with = "ne_range")]
-        ne: f32,
-        /// The optic axis in the stone's object space (relative to the cut), any non-zero
-        /// length.
-        #[serde(deserialize_with = "super::surface::axis_check")]
-        axis: (f32, f32, f32),
-        /// Dichroism: absorption that depends on the wave (default none).
-        #[serde(default)]
-        pleochroism: Option<PleochroismDesc>,
-    },
-}
-
-/// A dichroic crystal's absorption per wave, on top of the body's `medium`: the colour white
-/// light keeps after `distance` when it travels as the ordinary wave (ω) and as the
-/// extraordinary wave across the axis (ε, its field along the axis); an extraordinary wave at
-/// angle θ to the axis absorbs `σ_ω cos² θ + σ_ε sin² θ`.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct PleochroismDesc {
-    /// Colour of the ordinary wave after `distance` (each channel 0 <..= 1).
-    pub ordinary: super::color::ColorDesc,
-    /// Colour of the extraordinary wave (across the axis) after `distance`.
-    pub extraordinary: super::color::ColorDesc,
-    /// Object units, 0 <.. 1e4.
-    #[serde(deserialize_with = "pleochroism_distance")]
-    pub distance: f32,
-}
-
-impl PleochroismDesc {
-    /// The absorption coefficients per object unit `(σ_ω, σ_ε)`, or what is wrong.
-    pub fn coefficients(&self) -> Result<(crate::color::Rgb, crate::color::Rgb), String> {
-        let sigma = |c: &super::color::ColorDesc, name: &str| {
-            let rgb = c.to_rgb().map_err(|e| format!("pleochroism.{name}: {e}"))?;
-            if rgb.0.iter().all(|v| *v > 0.0 && *v <= 1.0) {
-                Ok(rgb.map(|v| -v.ln() / self.distance))
-            } else {
-                Err(format!(
-                    "pleochroism.{name} = {:?}: each channel must be in 0 <..= 1 (the share of \
-                     white light kept after `distance`)",
-                    rgb.0
-                ))
-            }
-        };
-        Ok((
-            sigma(&self.ordinary, "ordinary")?,
-            sigma(&self.extraordinary, "extraordinary")?,
-        ))
-    }
 }
 
 /// A homogeneous interior. Give the absorption either as coefficients or as a colour after a

@@ -9,7 +9,6 @@ use super::gem::GemRecipe;
 use super::map_compiler::{BODY_LEAF, Compiler};
 use super::source::Source;
 use crate::bsdf::StackDesc;
-use crate::color::Rgb;
 use crate::sampler::hash_words;
 use crate::scene::{Accuracy, Body, Effect, Interior, Scene, Surface, accuracy};
 use crate::texture::{Map, MapNode};
@@ -328,33 +327,10 @@ impl Compiler<'_> {
             },
         };
         let (platelets, platelet_materials) = self.platelets(desc, body_index, at.unwrap_or(0))?;
-        let crystal = match &desc.crystal {
+        let crystal = match desc.crystal.as_ref().map(|c| self.crystal(r, c, desc.ior, at)) {
             None => None,
-            Some(super::body::CrystalDesc::Uniaxial {
-                ne,
-                axis,
-                pleochroism,
-            }) => {
-                let (sigma_o, sigma_e) = match pleochroism.as_ref().map(|p| p.coefficients()) {
-                    None => (Rgb::ZERO, Rgb::ZERO),
-                    Some(Ok(s)) => s,
-                    Some(Err(m)) => {
-                        let at = r
-                            .source
-                            .find_from(at.unwrap_or(0), &["pleochroism", ":"])
-                            .or(at);
-                        self.errors
-                            .push(r.source.error(at, format!("body.crystal.{m}")));
-                        return None;
-                    }
-                };
-                Some(crate::scene::body::Crystal {
-                    ne: *ne,
-                    axis: glam::Vec3::new(axis.0, axis.1, axis.2).normalize(),
-                    sigma_o,
-                    sigma_e,
-                })
-            }
+            Some(Some(c)) => Some(c),
+            Some(None) => return None,
         };
         let body = Body {
             ior: desc.ior,

@@ -12,6 +12,7 @@
 mod ranged;
 pub mod body;
 pub mod color;
+pub mod crystal;
 mod compile;
 pub mod cut;
 pub mod dispersion;

@@ -10,6 +10,7 @@ use crate::polarisation::boundary::{Boundary, Mode};
 use crate::polarisation::crystal;
 use crate::polarisation::stokes::{ROWS, StokesRows};
 use crate::polarisation::transport::{InterfaceEvent, MAX_CHANNELS, PathPolarisation};
+use crate::polarisation::optics::Optics;
 use crate::polarisation::uniaxial::Uniaxial;
 use crate::spectrum::Spectral;
 use glam::Vec3;
@@ -157,11 +158,7 @@ where
     let facing = if n.dot(wo) > 0.0 { n } else { -n };
     let normal = if outside { facing } else { -facing };
     let b = Boundary {
-        crystal: Uniaxial {
-            no,
-            ne: no + f64::from(crystal.birefringence),
-            axis: crystal.axis.as_dvec3(),
-        },
+        crystal: crystal.at(no),
         n1: 1.0,
         normal,
     };
@@ -221,11 +218,13 @@ where
 }
 
 /// The transmittance over distance `t` of a pleochroic crystal for the wave the path's segment
-/// carries, the camera ray travelling along `dir` (unit): `exp(−σ t)` with `σ = σ_ω` for the
-/// ordinary wave and `σ_ω cos² θ + σ_ε sin² θ` for the extraordinary, `θ` between its wave normal
-/// and the axis. A segment that has no wave yet (after a depolarising vertex) takes one, each
-/// with probability ½ and weight 1 (the unpolarised row is the mean of the two orthogonal waves'),
-/// with `u ∈ [0, 1)`.
+/// carries, the camera ray travelling along `dir` (unit). Uniaxial: `exp(−σ t)` with `σ = σ_ω`
+/// for the ordinary wave and `σ_ω cos² θ + σ_ε sin² θ` for the extraordinary, `θ` between its
+/// wave normal and the axis; biaxial: `σ = Σ (D̂·aᵢ)² σᵢ` over the principal axes, `D̂` the
+/// wave's unit displacement ([`crate::polarisation::optics::Optics::absorption_weights`]). A
+/// segment that has no wave yet (after a depolarising vertex) takes one, each with probability ½
+/// and weight 1 (the unpolarised row is the mean of the two orthogonal waves'), with
+/// `u ∈ [0, 1)`.
 pub(super) fn pleochroic_transmittance<S: Spectral>(
     crystal: &CrystalOptics,
     pol: &mut PathPolarisation,
@@ -234,26 +233,37 @@ pub(super) fn pleochroic_transmittance<S: Spectral>(
     u: f32,
     lambda: &S::Wavelengths,
 ) -> S {
-    let optics = Uniaxial {
-        no: f64::from(crystal.no),
-        ne: f64::from(crystal.no + crystal.birefringence),
-        axis: crystal.axis.as_dvec3(),
+    let optics = crystal.at(f64::from(crystal.no));
+    let optics = match (crystal.biaxial, optics) {
+        // The uniaxial extraordinary index as the d line's f32 sum (as it always was).
+        (None, Optics::Uniaxial(x)) => Optics::Uniaxial(Uniaxial {
+            ne: f64::from(crystal.no + crystal.birefringence),
+            ..x
+        }),
+        (_, o) => o,
     };
     let ray = dir.as_dvec3();
+    let modes = optics.modes();
     let mode = match pol.mode {
         Some(m) => m,
         None => {
-            let m = if u < 0.5 { Mode::O } else { Mode::E };
+            let m = if u < 0.5 { modes[0] } else { modes[1] };
             *pol = crystal::pure_state(&optics, ray, m);
             m
         }
     };
-    let sigma = match mode {
-        Mode::O => crystal.sigma[0],
-        _ => {
-            let k = crystal::wave_direction(&optics, ray, mode);
-            let c2 = k.dot(optics.axis).powi(2) as f32;
+    let sigma = match (mode, &optics) {
+        (Mode::O, _) => crystal.sigma[0],
+        (_, Optics::Uniaxial(x)) => {
+            let k = optics.wave_of_ray(ray, mode);
+            let c2 = k.dot(x.axis).powi(2) as f32;
             crystal.sigma[0] * c2 + crystal.sigma[1] * (1.0 - c2)
+        }
+        (_, Optics::Biaxial(_)) => {
+            let w = optics.absorption_weights(ray, mode).unwrap_or([1.0 / 3.0; 3]);
+            crystal.sigma[0] * (w[0] as f32)
+                + crystal.sigma[1] * (w[1] as f32)
+                + crystal.sigma[2] * (w[2] as f32)
         }
     };
     S::from_unbounded(sigma, lambda).map(|s| (-s * t).exp())

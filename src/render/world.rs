@@ -11,6 +11,7 @@ use crate::color::Rgb;
 use crate::geometry::{MediumId, Ray, Stone, StoneHit};
 use crate::light::{Area, EnvironmentLight};
 use crate::medium::Medium;
+use crate::scene::body::Indices;
 use crate::scene::{Effect, Scene};
 use crate::texture::{Map, MapEffects};
 use glam::Vec3;
@@ -143,24 +144,45 @@ pub struct World {
     pub crystal: Option<CrystalOptics>,
 }
 
-/// The optics of a uniaxial body in world space ([`crate::polarisation::crystal`]).
+/// The optics of a doubly refractive body in world space ([`crate::polarisation::crystal`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CrystalOptics {
-    /// Ordinary index at the d line.
+    /// The body's index at the d line: ordinary (ω) or n_α.
     pub no: f32,
-    /// Birefringence `n_e − n_o` at the d line, kept at every wavelength.
+    /// Uniaxial: `n_e − n_o` at the d line, kept at every wavelength (biaxial: 0).
     pub birefringence: f32,
-    /// Unit optic axis, world space.
+    /// Unit optic axis, world space (biaxial: its X axis).
     pub axis: Vec3,
-    /// Dichroic absorption per world unit of the ordinary wave and of the extraordinary wave
-    /// across the axis (zero: not pleochroic).
-    pub sigma: [Rgb; 2],
+    /// A biaxial crystal: `n_β − n_α`, `n_γ − n_α` at the d line (kept at every wavelength) and
+    /// its orthonormal principal axes X, Y, Z in world space.
+    pub biaxial: Option<([f32; 2], [Vec3; 3])>,
+    /// Dichroic absorption per world unit: uniaxial, of the ordinary wave and of the
+    /// extraordinary wave across the axis; biaxial, of light vibrating along X, Y, Z (zero: not
+    /// pleochroic).
+    pub sigma: [Rgb; 3],
 }
 
 impl CrystalOptics {
     /// Whether the absorption depends on the wave.
     pub fn pleochroic(&self) -> bool {
-        !(self.sigma[0].is_black() && self.sigma[1].is_black())
+        !self.sigma.iter().all(|s| s.is_black())
+    }
+
+    /// The optics at the wavelength where the body's index is `n` (the other principal indices
+    /// keep their differences from it).
+    pub fn at(&self, n: f64) -> crate::polarisation::optics::Optics {
+        use crate::polarisation::{biaxial::Biaxial, optics::Optics, uniaxial::Uniaxial};
+        match self.biaxial {
+            None => Optics::Uniaxial(Uniaxial {
+                no: n,
+                ne: n + f64::from(self.birefringence),
+                axis: self.axis.as_dvec3(),
+            }),
+            Some(([b, g], axes)) => Optics::Biaxial(Biaxial {
+                n: [n, n + f64::from(b), n + f64::from(g)],
+                axes: axes.map(|a| a.as_dvec3()),
+            }),
+        }
     }
 }
 
@@ -260,11 +282,29 @@ impl World {
                     .x_axis
                     .length()
                     .max(f32::MIN_POSITIVE);
-                CrystalOptics {
-                    no: ior,
-                    birefringence: c.ne - ior,
-                    axis: stage.to_world.transform_vector3(c.axis).normalize(),
-                    sigma: [c.sigma_o * (1.0 / scale), c.sigma_e * (1.0 / scale)],
+                let to_world = |v: Vec3| stage.to_world.transform_vector3(v).normalize();
+                let sigma = c.sigma.map(|s| s * (1.0 / scale));
+                match c.indices {
+                    Indices::Uniaxial { ne, axis } => CrystalOptics {
+                        no: ior,
+                        birefringence: ne - ior,
+                        axis: to_world(axis),
+                        biaxial: None,
+                        sigma,
+                    },
+                    Indices::Biaxial { beta, gamma, axes } => {
+                        // Orthonormal again in world space (Gram–Schmidt, X kept).
+                        let x = to_world(axes[0]);
+                        let z = to_world(axes[2]);
+                        let z = (z - x * z.dot(x)).normalize();
+                        CrystalOptics {
+                            no: ior,
+                            birefringence: 0.0,
+                            axis: x,
+                            biaxial: Some(([beta - ior, gamma - ior], [x, z.cross(x), z])),
+                            sigma,
+                        }
+                    }
                 }
             });
         if polarised && let Some(m) = inside.manifold.as_mut() {

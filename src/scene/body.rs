@@ -44,17 +44,42 @@ pub struct Body {
     pub crystal: Option<Crystal>,
 }
 
-/// The optics of a uniaxial body (object space).
+/// The optics of a doubly refractive body (object space).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Crystal {
-    /// Extraordinary index ε at the d line (the ordinary one is the body's `ior`).
-    pub ne: f32,
-    /// Unit optic axis, object space.
-    pub axis: glam::Vec3,
-    /// Absorption per object unit of the ordinary wave, on top of the medium's.
-    pub sigma_o: Rgb,
-    /// Absorption per object unit of the extraordinary wave across the axis.
-    pub sigma_e: Rgb,
+    /// Its indices beyond the body's `ior` and its axes.
+    pub indices: Indices,
+    /// Absorption per object unit on top of the medium's, per principal wave: uniaxial
+    /// `[ω, ε across the axis, 0]`; biaxial `[α, β, γ]` (light vibrating along X, Y, Z).
+    pub sigma: [Rgb; 3],
+}
+
+/// A crystal's principal indices and axes; the first index is the body's `ior`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Indices {
+    /// One optic axis.
+    Uniaxial {
+        /// Extraordinary index ε at the d line (the ordinary one, ω, is the body's `ior`).
+        ne: f32,
+        /// Unit optic axis.
+        axis: glam::Vec3,
+    },
+    /// Two optic axes.
+    Biaxial {
+        /// n_β at the d line (n_α is the body's `ior`).
+        beta: f32,
+        /// n_γ at the d line.
+        gamma: f32,
+        /// Orthonormal principal axes X, Y, Z (the vibration directions of n_α, n_β, n_γ).
+        axes: [glam::Vec3; 3],
+    },
+}
+
+impl Crystal {
+    /// Whether the absorption depends on the wave.
+    pub fn pleochroic(&self) -> bool {
+        !self.sigma.iter().all(|s| s.is_black())
+    }
 }
 
 /// A homogeneous interior as the recipe gives it (per object unit).

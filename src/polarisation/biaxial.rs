@@ -1,0 +1,538 @@
+//! A biaxial crystal (cordierite, the feldspars, peridot, topaz): three principal indices
+//! `n_α ≤ n_β ≤ n_γ` along three orthogonal axes X, Y, Z, two optic axes in the XZ plane, and
+//! along every other wave normal two waves — the fast one on the index surface's inner sheet and
+//! the slow one on its outer sheet — whose energy leaves the wave normal (Born & Wolf,
+//! *Principles of Optics*, 7th ed., §15.3; Yariv & Yeh, *Optical Waves in Crystals*, 1984, §4.2).
+//!
+//! Units as in [`super::uniaxial`]: a wave vector `k` in units of the vacuum wave number, `|k|`
+//! the wave's index, non-magnetic media. With the relative permittivity `ε = Σ n_i² a_i a_iᵀ`
+//! (`a_i` the principal axes) a plane wave's field solves `(k kᵀ − (k·k) I + ε) E = 0`, whose
+//! determinant — Fresnel's equation of wave normals — is
+//!
+//! `F(k) = (k·k)(kᵀ ε k) − kᵀ (tr ε · ε − ε²) k + det ε = 0`
+//!
+//! (expand `det(D + k kᵀ) = det D (1 + kᵀ D⁻¹ k)` with `D = ε − (k·k) I`). Along a unit wave
+//! normal `s` it is a quadratic in `n²`; on a boundary, with `k = t + u m`, a quartic in `u`
+//! ([`super::quartic`]). The ray — the direction energy travels — is the index surface's normal
+//! `∇F`, equal to the Poynting vector `E × (k × E)`.
+
+use super::quartic;
+use glam::DVec3;
+use num_complex::Complex64 as C;
+
+/// A complex 3-vector (bilinear products, as in [`super::boundary`]).
+pub type CVec = [C; 3];
+
+/// A biaxial crystal at one wavelength.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Biaxial {
+    /// Principal indices `[n_α, n_β, n_γ]`, each ≥ 1 (the order is not enforced here).
+    pub n: [f64; 3],
+    /// Principal axes X, Y, Z: orthonormal, the vibration directions of `n_α`, `n_β`, `n_γ`.
+    pub axes: [DVec3; 3],
+}
+
+/// Components of `v` along the axes (complex).
+fn along(axes: &[DVec3; 3], v: CVec) -> CVec {
+    axes.map(|a| v[0] * a.x + v[1] * a.y + v[2] * a.z)
+}
+
+fn cdot(a: CVec, b: CVec) -> C {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn ccross(a: CVec, b: CVec) -> CVec {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn cnorm(a: CVec) -> f64 {
+    a.iter().map(|c| c.norm_sqr()).sum::<f64>().sqrt()
+}
+
+/// A real vector as a complex one.
+pub fn complex(v: DVec3) -> CVec {
+    [C::from(v.x), C::from(v.y), C::from(v.z)]
+}
+
+impl Biaxial {
+    /// The principal permittivities `n_i²`.
+    fn eps(&self) -> [f64; 3] {
+        self.n.map(|n| n * n)
+    }
+
+    /// The quadratic forms `kᵀ ε k` and `kᵀ (tr ε · ε − ε²) k` from the components along the
+    /// axes, and `det ε`.
+    fn forms(&self, k: [C; 3]) -> (C, C, f64) {
+        let e = self.eps();
+        let tr = e[0] + e[1] + e[2];
+        let mut a = C::from(0.0);
+        let mut b = C::from(0.0);
+        for i in 0..3 {
+            let k2 = k[i] * k[i];
+            a += e[i] * k2;
+            b += e[i] * (tr - e[i]) * k2;
+        }
+        (a, b, e[0] * e[1] * e[2])
+    }
+
+    /// The two indices along the unit wave normal `s`, `[fast, slow]` (equal along an optic
+    /// axis): the roots of `a N² − b N + det ε = 0` in `N = n²`, the slow one first and the fast
+    /// one from the product of the roots (no cancellation).
+    pub fn indices(&self, s: DVec3) -> [f64; 2] {
+        let (a, b, c) = self.forms(along(&self.axes, complex(s)));
+        let (a, b) = (a.re, b.re);
+        let disc = (b * b - 4.0 * a * c).max(0.0);
+        let slow = (b + disc.sqrt()) / (2.0 * a);
+        let fast = c / (a * slow);
+        [fast.sqrt(), slow.sqrt()]
+    }
+
+    /// The unit ray (the index surface's normal) of the real wave vector `k` on the surface;
+    /// `k`'s direction at a conical point, where the normal is not defined.
+    pub fn ray(&self, k: DVec3) -> DVec3 {
+        let e = self.eps();
+        let tr = e[0] + e[1] + e[2];
+        let kk = k.length_squared();
+        let c = self.axes.map(|a| a.dot(k));
+        let kek: f64 = (0..3).map(|i| e[i] * c[i] * c[i]).sum();
+        // ∇F / 2 = (kᵀεk) k + (k·k) ε k − (tr ε · ε − ε²) k.
+        let mut g = kek * k;
+        for i in 0..3 {
+            g += (kk * e[i] - e[i] * (tr - e[i])) * c[i] * self.axes[i];
+        }
+        let g = if g.dot(k) < 0.0 { -g } else { g };
+        g.try_normalize().unwrap_or_else(|| k.normalize())
+    }
+
+    /// The unit wave normal of the wave on sheet `slow` (false: the fast wave) whose ray is the
+    /// unit `ray`, in closed form by duality (Born & Wolf §15.2.4): the ray surface — the ray
+    /// velocities `v_r t` along unit rays `t` — is the index surface of the crystal with indices
+    /// `1/nᵢ`, and a wave normal is that surface's normal, as the ray is the index surface's.
+    /// Each of the ray surface's two sheets gives a normal; the sheets do not pair with the index
+    /// surface's everywhere (near an optic axis, the cone of internal conical refraction crosses
+    /// a ray axis where the ray sheets touch), so the normal kept is the one whose own ray on
+    /// sheet `slow` is `ray`. At a conical point of the ray surface (a ray along a ray axis,
+    /// which belongs to a cone of normals) the ray itself.
+    pub fn wave_of_ray(&self, ray: DVec3, slow: bool) -> DVec3 {
+        let dual = Biaxial {
+            n: self.n.map(|n| 1.0 / n),
+            axes: self.axes,
+        };
+        let [a, b] = dual.indices(ray).map(|v| dual.ray(v * ray));
+        let miss = |s: DVec3| (self.ray(self.indices(s)[usize::from(slow)] * s) - ray).length_squared();
+        if miss(a) <= miss(b) { a } else { b }
+    }
+
+    /// The rows of `M = k kᵀ − (k·k) I + ε`, whose null vectors are the fields of a wave with
+    /// wave vector `k`.
+    fn rows(&self, k: CVec) -> [CVec; 3] {
+        let e = self.eps();
+        let kk = cdot(k, k);
+        std::array::from_fn(|j| {
+            let mut r = [k[j] * k[0], k[j] * k[1], k[j] * k[2]];
+            r[j] -= kk;
+            // + ε_j· = Σ_i n_i² a_ij a_i·
+            for (i, a) in self.axes.iter().enumerate() {
+                let (aj, al) = (a.to_array()[j], a.to_array());
+                for (l, v) in r.iter_mut().enumerate() {
+                    *v += e[i] * aj * al[l];
+                }
+            }
+            r
+        })
+    }
+
+    /// The electric field of a wave with wave vector `k` (complex when evanescent): the null
+    /// vector of `M`, the largest cross product of two of its rows; where `M` has rank one (the
+    /// two waves coincide: along an optic axis) the first of [`Biaxial::degenerate_fields`].
+    pub fn field(&self, k: CVec, reference: DVec3, second: bool) -> CVec {
+        let rows = self.rows(k);
+        let scale = self.n.iter().fold(0.0f64, |m, v| m.max(v * v)).powi(2);
+        let mut best = ccross(rows[0], rows[1]);
+        for cand in [ccross(rows[1], rows[2]), ccross(rows[2], rows[0])] {
+            if cnorm(cand) > cnorm(best) {
+                best = cand;
+            }
+        }
+        let nb = cnorm(best);
+        if nb > 1e-7 * scale {
+            best.map(|c| c / nb)
+        } else {
+            self.degenerate_fields(k, reference)[usize::from(second)]
+        }
+    }
+
+    /// Two orthogonal fields of a wave along an optic axis, where every field across `M`'s one
+    /// independent row `r` is a wave: `reference` made across `r`, then `r ×` that.
+    pub fn degenerate_fields(&self, k: CVec, reference: DVec3) -> [CVec; 2] {
+        let r = self
+            .rows(k)
+            .into_iter()
+            .max_by(|a, b| cnorm(*a).total_cmp(&cnorm(*b)))
+            .unwrap_or([C::from(0.0); 3]);
+        let rr = cdot(r, r);
+        let x = complex(reference);
+        let first = if rr.norm() > 0.0 {
+            let f = cdot(r, x) / rr;
+            [x[0] - f * r[0], x[1] - f * r[1], x[2] - f * r[2]]
+        } else {
+            x
+        };
+        let unit = |v: CVec| {
+            let nv = cnorm(v);
+            if nv > 0.0 { v.map(|c| c / nv) } else { x }
+        };
+        [unit(first), unit(ccross(r, first))]
+    }
+
+    /// The unit displacement `D = ε E` (across the wave normal) of a real field `e`.
+    pub fn displacement(&self, e: DVec3) -> DVec3 {
+        let eps = self.eps();
+        let d: DVec3 = (0..3).map(|i| eps[i] * self.axes[i].dot(e) * self.axes[i]).sum();
+        d.normalize_or_zero()
+    }
+
+    /// The normal components `u` of the four waves `k = t + u m` with tangential wave vector `t`
+    /// on a boundary with unit normal `m` (`t · m = 0`): the roots of the quartic `F(t + u m)`.
+    pub fn normal_components(&self, t: DVec3, m: DVec3) -> Option<[C; 4]> {
+        let e = self.eps();
+        let tr = e[0] + e[1] + e[2];
+        let tc = self.axes.map(|a| a.dot(t));
+        let mc = self.axes.map(|a| a.dot(m));
+        // kᵀεk = a0 + a1 u + a2 u², kᵀ(tr ε ε − ε²)k = b0 + b1 u + b2 u².
+        let (mut a, mut b) = ([0.0; 3], [0.0; 3]);
+        for i in 0..3 {
+            let w = [e[i], e[i] * (tr - e[i])];
+            for (f, wi) in [(&mut a, w[0]), (&mut b, w[1])] {
+                f[0] += wi * tc[i] * tc[i];
+                f[1] += 2.0 * wi * tc[i] * mc[i];
+                f[2] += wi * mc[i] * mc[i];
+            }
+        }
+        let tt = t.length_squared();
+        let det = e[0] * e[1] * e[2];
+        // (tt + u²)(a0 + a1 u + a2 u²) − (b0 + b1 u + b2 u²) + det.
+        let c4 = a[2];
+        if !(c4 > 0.0) {
+            return None;
+        }
+        let c = [
+            (tt * a[0] - b[0] + det) / c4,
+            (tt * a[1] - b[1]) / c4,
+            (a[0] + tt * a[2] - b[2]) / c4,
+            a[1] / c4,
+        ];
+        // Start from each sheet's index along the wave an isotropic medium of index n_β would
+        // carry, up and down (imaginary when evanescent), tilted off the real axis so that no
+        // two starts coincide: within about Δn × walk-off of the roots.
+        let q = |n: f64| C::from(n * n - tt).sqrt();
+        let qb = q(self.n[1]).re;
+        let guess = |up: bool| -> [C; 2] {
+            let d = t + if up { qb } else { -qb } * m;
+            let sheets = d.try_normalize().map_or(self.n, |d| {
+                let [f, s] = self.indices(d);
+                [f, s, 0.0]
+            });
+            let sign = if up { 1.0 } else { -1.0 };
+            [sign * q(sheets[0]), sign * q(sheets[1])]
+        };
+        let ([uf, us], [df, ds]) = (guess(true), guess(false));
+        let start = [
+            uf * C::new(1.0, 1e-3),
+            df * C::new(1.0, 2e-3),
+            us * C::new(1.0, -1e-3) + C::new(1e-4, 0.0),
+            ds * C::new(1.0, -2e-3) - C::new(1e-4, 0.0),
+        ];
+        quartic::roots(c, Some(start))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::polarisation::uniaxial::Uniaxial;
+    use crate::sampler::Rng;
+
+    fn random_unit(rng: &mut Rng) -> DVec3 {
+        let z = 2.0 * f64::from(rng.uniform()) - 1.0;
+        let phi = std::f64::consts::TAU * f64::from(rng.uniform());
+        let r = (1.0 - z * z).sqrt();
+        DVec3::new(r * phi.cos(), r * phi.sin(), z)
+    }
+
+    /// A random orthonormal frame.
+    fn random_axes(rng: &mut Rng) -> [DVec3; 3] {
+        let x = random_unit(rng);
+        let y = x.cross(random_unit(rng)).normalize();
+        [x, y, x.cross(y)]
+    }
+
+    /// Cordierite (iolite) at the d line, mid-range of its published indices (Deer, Howie &
+    /// Zussman, *Rock-Forming Minerals* vol. 1B, 1986: n_α 1.522–1.560, n_β 1.524–1.574,
+    /// n_γ 1.527–1.578); a strongly birefringent made-up crystal beside it for larger walk-offs.
+    const IOLITE: [f64; 3] = [1.537, 1.542, 1.546];
+    const STRONG: [f64; 3] = [1.5, 1.65, 1.72];
+
+    /// With two equal indices the crystal is uniaxial: the indices and rays equal
+    /// [`Uniaxial`]'s ordinary and extraordinary ones (positive: axis Z; negative: axis X).
+    #[test]
+    fn two_equal_indices_are_uniaxial() {
+        let mut rng = Rng::new(1);
+        for _ in 0..500 {
+            let axes = random_axes(&mut rng);
+            let s = random_unit(&mut rng);
+            for (n, axis, o_fast) in [
+                ([1.5, 1.5, 1.7], axes[2], true),
+                ([1.5, 1.7, 1.7], axes[0], false),
+            ] {
+                let b = Biaxial { n, axes };
+                let u = Uniaxial {
+                    no: if o_fast { 1.5 } else { 1.7 },
+                    ne: if o_fast { 1.7 } else { 1.5 },
+                    axis,
+                };
+                let [fast, slow] = b.indices(s);
+                let (no, ne) = (u.no, u.extraordinary_index(s));
+                let (want_fast, want_slow) = if o_fast { (no, ne) } else { (ne, no) };
+                assert!((fast - want_fast).abs() < 1e-12 && (slow - want_slow).abs() < 1e-12);
+                // The extraordinary sheet's ray (the slow sheet where the ordinary is fast).
+                let e_slow = o_fast;
+                let k = ne * s;
+                let r = b.ray(b.indices(s)[usize::from(e_slow)] * s);
+                assert!((r - u.ray(k)).length() < 1e-9, "{r} vs {}", u.ray(k));
+            }
+        }
+    }
+
+    /// Both indices of every wave normal satisfy Fresnel's equation, and along an optic axis —
+    /// in the XZ plane at `V` from Z, `tan V = (n_γ/n_α) √((n_β² − n_α²)/(n_γ² − n_β²))` (Born &
+    /// Wolf §15.3.3, eq. 25) — the two coincide.
+    #[test]
+    fn indices_solve_fresnels_equation_and_meet_on_the_optic_axes() {
+        let mut rng = Rng::new(2);
+        for n in [IOLITE, STRONG] {
+            let b = Biaxial {
+                n,
+                axes: random_axes(&mut rng),
+            };
+            for _ in 0..200 {
+                let s = random_unit(&mut rng);
+                for idx in b.indices(s) {
+                    assert!((n[0] - 1e-12..=n[2] + 1e-12).contains(&idx));
+                    let (a, bb, c) = b.forms(along(&b.axes, complex(idx * s)));
+                    let f = idx * idx * a - bb + c;
+                    assert!(f.norm() < 1e-10, "{f}");
+                }
+            }
+            let [a, bb, g] = n.map(|v| v * v);
+            let v = ((g / a) * ((bb - a) / (g - bb))).sqrt().atan();
+            let axis = v.cos() * b.axes[2] + v.sin() * b.axes[0];
+            let [fast, slow] = b.indices(axis);
+            assert!((fast - n[1]).abs() < 1e-7 && (slow - n[1]).abs() < 1e-7);
+            let off = (v + 0.05).cos() * b.axes[2] + (v + 0.05).sin() * b.axes[0];
+            let [f2, s2] = b.indices(off);
+            assert!(s2 - f2 > 1e-5, "{f2} {s2}");
+        }
+    }
+
+    /// The ray is the Poynting vector `E × (k × E)` of the wave's own field, and inverting it
+    /// gives a wave normal of the same sheet with that ray — the normal itself except near an
+    /// optic axis.
+    #[test]
+    fn the_ray_is_the_poynting_vector_and_inverts() {
+        let mut rng = Rng::new(3);
+        let (mut tried, mut same) = (0, 0);
+        for _ in 0..1000 {
+            let b = Biaxial {
+                n: STRONG,
+                axes: random_axes(&mut rng),
+            };
+            let s = random_unit(&mut rng);
+            for slow in [false, true] {
+                let k = b.indices(s)[usize::from(slow)] * s;
+                let e = b.field(complex(k), DVec3::X, false);
+                let e = DVec3::new(e[0].re, e[1].re, e[2].re);
+                let poynting = (e.cross(k.cross(e))).normalize();
+                let r = b.ray(k);
+                // Skip the few normals within a degree of an optic axis (the field is
+                // undefined there).
+                let [f, sl] = b.indices(s);
+                if sl - f < 1e-3 {
+                    continue;
+                }
+                assert!((r - poynting).length() < 1e-8, "{r} {poynting}");
+                let back = b.wave_of_ray(r, slow);
+                let again = b.ray(b.indices(back)[usize::from(slow)] * back);
+                assert!((again - r).length() < 1e-9, "{again} vs {r}");
+                tried += 1;
+                same += usize::from((back - s).length() < 1e-9);
+            }
+        }
+        // Near an optic axis the outer sheet is not convex and two normals share a ray: either
+        // is a wave with that ray. Elsewhere the normal itself comes back.
+        assert!(same as f64 > 0.97 * tried as f64, "{same} of {tried}");
+    }
+
+    /// The boundary quartic's real roots are waves on the index surface with the given
+    /// tangential component.
+    #[test]
+    fn boundary_roots_lie_on_the_index_surface() {
+        let mut rng = Rng::new(4);
+        for _ in 0..500 {
+            let b = Biaxial {
+                n: STRONG,
+                axes: random_axes(&mut rng),
+            };
+            let m = random_unit(&mut rng);
+            let t = 1.3 * f64::from(rng.uniform()) * m.any_orthonormal_vector();
+            let roots = b.normal_components(t, m).unwrap();
+            for u in roots {
+                let k = [0, 1, 2].map(|i| C::from(t.to_array()[i]) + u * m.to_array()[i]);
+                let (a, bb, c) = b.forms(along(&b.axes, k));
+                let f = cdot(k, k) * a - bb + c;
+                assert!(f.norm() < 1e-8, "{u}: {f}");
+            }
+            // |t| < n_α: all four waves propagate.
+            assert!(roots.iter().all(|u| u.im.abs() < 1e-9), "{roots:?}");
+        }
+    }
+
+    mod boundary {
+        use super::*;
+        use crate::polarisation::boundary::{Boundary, Incident, Mode};
+        use crate::polarisation::optics::Optics;
+
+        fn boundary(n: [f64; 3], axes: [DVec3; 3]) -> Boundary {
+            Boundary {
+                crystal: Optics::Biaxial(Biaxial { n, axes }),
+                n1: 1.0,
+                normal: DVec3::Z,
+            }
+        }
+
+        /// An incident wave from outside (`S`/`P`) or inside (one of the crystal's waves whose
+        /// energy reaches the boundary), drawn at random.
+        fn incident(b: &Boundary, rng: &mut Rng, inside: bool) -> Option<Incident> {
+            let mut d = random_unit(rng);
+            if inside {
+                d.z = d.z.abs();
+                let mode = b.crystal.modes()[usize::from(rng.uniform() < 0.5)];
+                (b.crystal.ray(d, mode).z > 1e-6).then_some(Incident::Inside { dir: d, mode })
+            } else {
+                d.z = -d.z.abs();
+                let mode = if rng.uniform() < 0.5 { Mode::S } else { Mode::P };
+                Some(Incident::Outside { dir: d, mode })
+            }
+        }
+
+        /// With two equal indices the biaxial boundary is the uniaxial one: the same powers into
+        /// the same waves (fast = ordinary for a positive crystal, extraordinary for a negative
+        /// one), from outside and from inside, over random axes and directions.
+        #[test]
+        fn two_equal_indices_give_the_uniaxial_boundary() {
+            let mut rng = Rng::new(31);
+            let mut compared = 0;
+            for i in 0..2000 {
+                let axes = random_axes(&mut rng);
+                let positive = i % 2 == 0;
+                let (n, u) = if positive {
+                    ([1.5, 1.5, 1.7], Uniaxial { no: 1.5, ne: 1.7, axis: axes[2] })
+                } else {
+                    ([1.5, 1.7, 1.7], Uniaxial { no: 1.7, ne: 1.5, axis: axes[0] })
+                };
+                let bx = boundary(n, axes);
+                let bu = Boundary { crystal: Optics::Uniaxial(u), ..bx };
+                let map = |m: Mode| match (m, positive) {
+                    (Mode::Fast, true) | (Mode::Slow, false) => Mode::O,
+                    (Mode::Fast, false) | (Mode::Slow, true) => Mode::E,
+                    (m, _) => m,
+                };
+                let Some(inc) = incident(&bx, &mut rng, i % 4 >= 2) else { continue };
+                let inc_u = match inc {
+                    Incident::Inside { dir, mode } => Incident::Inside { dir, mode: map(mode) },
+                    o => o,
+                };
+                let (Some(x), Some(y)) = (bx.solve(inc, DVec3::X), bu.solve(inc_u, DVec3::X))
+                else {
+                    continue;
+                };
+                for o in &x {
+                    let twin = y.iter().find(|w| w.wave.mode == map(o.wave.mode)).unwrap();
+                    assert!(
+                        (o.power - twin.power).abs() < 1e-7,
+                        "{inc:?} {:?}: {} vs {}",
+                        o.wave.mode,
+                        o.power,
+                        twin.power
+                    );
+                }
+                compared += 1;
+            }
+            assert!(compared > 1800, "{compared}");
+        }
+
+        /// Energy is conserved for every incident wave, crystal and axes, inside and out (total
+        /// internal reflection of either wave included), for iolite and a strongly biaxial
+        /// crystal.
+        #[test]
+        fn power_is_conserved() {
+            let mut rng = Rng::new(32);
+            let mut solved = 0;
+            for i in 0..4000 {
+                let n = if i % 2 == 0 { IOLITE } else { STRONG };
+                let b = boundary(n, random_axes(&mut rng));
+                let Some(inc) = incident(&b, &mut rng, i % 4 >= 2) else { continue };
+                let Some(out) = b.solve(inc, DVec3::X) else { continue };
+                solved += 1;
+                let total: f64 = out.iter().map(|o| o.power).sum();
+                assert!((total - 1.0).abs() < 1e-7, "{inc:?}: {total} {out:?}");
+                assert!(out.iter().all(|o| o.power >= -1e-12));
+            }
+            assert!(solved > 3500, "{solved}");
+        }
+
+        /// Reciprocity: what an s or p wave from outside sends into a crystal wave equals what
+        /// that wave, reversed, sends into the reversed s or p wave.
+        #[test]
+        fn transmission_is_reciprocal() {
+            let mut rng = Rng::new(33);
+            let mut checked = 0;
+            for i in 0..600 {
+                let n = if i % 2 == 0 { IOLITE } else { STRONG };
+                let b = boundary(n, random_axes(&mut rng));
+                let mut d = random_unit(&mut rng);
+                d.z = -d.z.abs().max(0.05);
+                let d = d.normalize();
+                for mode in [Mode::S, Mode::P] {
+                    let fwd = b.solve(Incident::Outside { dir: d, mode }, DVec3::X).unwrap();
+                    for j in [2, 3] {
+                        let w = fwd[j].wave;
+                        if !w.propagating() || fwd[j].power < 1e-9 {
+                            continue;
+                        }
+                        let back = b
+                            .solve(
+                                Incident::Inside { dir: -w.direction(), mode: w.mode },
+                                DVec3::X,
+                            )
+                            .unwrap();
+                        let k = if mode == Mode::S { 0 } else { 1 };
+                        assert!(
+                            (back[k].power - fwd[j].power).abs() < 1e-7,
+                            "{mode:?}→{:?}: {} vs {}",
+                            w.mode,
+                            fwd[j].power,
+                            back[k].power
+                        );
+                        checked += 1;
+                    }
+                }
+            }
+            assert!(checked > 2000, "{checked}");
+        }
+    }
+}

@@ -1,0 +1,282 @@
+//! Serde description of a doubly refractive body's `crystal` (part of [`super::body`]): uniaxial
+//! or biaxial indices and axes, and the pleochroic absorption per wave. Compiles into
+//! [`crate::scene::body::Crystal`].
+//!
+//! ```ron
+//! crystal: Uniaxial(ne: 1.640, axis: (0.0, 0.0, 1.0),     // ω is the body's `ior`
+//!     pleochroism: Some((ordinary: Srgb(0.2, 0.3, 0.1), extraordinary: Srgb(0.5, 0.8, 0.4),
+//!                        distance: 1.0))),
+//! crystal: Biaxial(beta: 1.542, gamma: 1.546,            // n_α is the body's `ior`
+//!     x_axis: (1.0, 0.0, 0.0), z_axis: (0.0, 0.0, 1.0),  // the vibration directions of α, γ
+//!     pleochroism: Some((alpha: …, beta: …, gamma: …, distance: 1.0))),
+//! ```
+
+use super::color::ColorDesc;
+use crate::color::Rgb;
+use serde::{Deserialize, Deserializer, Serialize};
+
+ranged!(ne_range, "crystal.ne", 1.0001, 4.0);
+ranged!(beta_range, "crystal.beta", 1.0001, 4.0);
+ranged!(gamma_range, "crystal.gamma", 1.0001, 4.0);
+ranged!(pleochroism_distance, "pleochroism.distance", open 0.0, 1e4);
+
+/// The optics of a doubly refractive body.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum CrystalDesc {
+    /// A uniaxial crystal (quartz, calcite, tourmaline, zircon, corundum, beryl): waves across
+    /// the optic axis polarised along it meet the extraordinary index `ne` (ε), every other
+    /// polarisation the ordinary `ior` (ω).
+    Uniaxial {
+        /// Extraordinary index ε, 1.0001 ..= 4 (with a `dispersion`, at the d line; the
+        /// birefringence ε − ω is kept at every wavelength).
+        #[serde(deserialize_with = "ne_range")]
+        ne: f32,
+        /// The optic axis in the stone's object space (relative to the cut), any non-zero
+        /// length.
+        #[serde(deserialize_with = "super::surface::axis_check")]
+        axis: (f32, f32, f32),
+        /// Dichroism: absorption that depends on the wave (default none).
+        #[serde(default)]
+        pleochroism: Option<PleochroismDesc>,
+    },
+    /// A biaxial crystal (cordierite — iolite —, the feldspars, peridot, topaz): light vibrating
+    /// along the principal axis X meets the body's `ior` (n_α), along Y `beta` (n_β), along Z
+    /// `gamma` (n_γ), with `ior ≤ beta ≤ gamma`.
+    Biaxial {
+        /// n_β, 1.0001 ..= 4, at least the body's `ior` (with a `dispersion`, at the d line;
+        /// n_β − n_α is kept at every wavelength).
+        #[serde(deserialize_with = "beta_range")]
+        beta: f32,
+        /// n_γ, 1.0001 ..= 4, at least `beta` (n_γ − n_α kept likewise).
+        #[serde(deserialize_with = "gamma_range")]
+        gamma: f32,
+        /// The X axis (n_α's vibration direction) in the stone's object space, any non-zero
+        /// length.
+        #[serde(deserialize_with = "super::surface::axis_check")]
+        x_axis: (f32, f32, f32),
+        /// The Z axis (n_γ's), at least 5° from `x_axis`; made orthogonal to it (Y = Z × X).
+        #[serde(deserialize_with = "super::surface::axis_check")]
+        z_axis: (f32, f32, f32),
+        /// Trichroism: absorption that depends on the vibration direction (default none).
+        #[serde(default)]
+        pleochroism: Option<TrichroismDesc>,
+    },
+}
+
+/// Sin² of the smallest angle allowed between a biaxial crystal's `x_axis` and `z_axis` (5°).
+const MIN_AXES_SIN2: f32 = 0.007_596;
+
+/// What white light keeps of each channel after `distance` as an absorption coefficient per
+/// object unit, `−ln(colour)/distance`, or what is wrong with `name`.
+fn sigma(c: &ColorDesc, name: &str, distance: f32) -> Result<Rgb, String> {
+    let rgb = c.to_rgb().map_err(|e| format!("pleochroism.{name}: {e}"))?;
+    if rgb.0.iter().all(|v| *v > 0.0 && *v <= 1.0) {
+        Ok(rgb.map(|v| -v.ln() / distance))
+    } else {
+        Err(format!(
+            "pleochroism.{name} = {:?}: each channel must be in 0 <..= 1 (the share of white \
+             light kept after `distance`)",
+            rgb.0
+        ))
+    }
+}
+
+/// A dichroic crystal's absorption per wave, on top of the body's `medium`: the colour white
+/// light keeps after `distance` when it travels as the ordinary wave (ω) and as the
+/// extraordinary wave across the axis (ε, its field along the axis); an extraordinary wave at
+/// angle θ to the axis absorbs `σ_ω cos² θ + σ_ε sin² θ`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PleochroismDesc {
+    /// Colour of the ordinary wave after `distance` (each channel 0 <..= 1).
+    pub ordinary: ColorDesc,
+    /// Colour of the extraordinary wave (across the axis) after `distance`.
+    pub extraordinary: ColorDesc,
+    /// Object units, 0 <.. 1e4.
+    #[serde(deserialize_with = "pleochroism_distance")]
+    pub distance: f32,
+}
+
+impl PleochroismDesc {
+    /// The absorption coefficients per object unit `(σ_ω, σ_ε)`, or what is wrong.
+    pub fn coefficients(&self) -> Result<(Rgb, Rgb), String> {
+        Ok((
+            sigma(&self.ordinary, "ordinary", self.distance)?,
+            sigma(&self.extraordinary, "extraordinary", self.distance)?,
+        ))
+    }
+}
+
+/// A trichroic crystal's absorption, on top of the body's `medium`: the colour white light keeps
+/// after `distance` when it vibrates along X (`alpha`), Y (`beta`) and Z (`gamma`) — what a
+/// dichroscope shows looking along the other two axes. A wave whose unit displacement is `D̂`
+/// absorbs `Σ (D̂·aᵢ)² σᵢ` (the absorbing crystal's quadratic form, Born & Wolf, *Principles of
+/// Optics*, §15.6).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TrichroismDesc {
+    /// Colour of light vibrating along X after `distance` (each channel 0 <..= 1).
+    pub alpha: ColorDesc,
+    /// Along Y.
+    pub beta: ColorDesc,
+    /// Along Z.
+    pub gamma: ColorDesc,
+    /// Object units, 0 <.. 1e4.
+    #[serde(deserialize_with = "pleochroism_distance")]
+    pub distance: f32,
+}
+
+impl TrichroismDesc {
+    /// The absorption coefficients per object unit `[σ_α, σ_β, σ_γ]`, or what is wrong.
+    pub fn coefficients(&self) -> Result<[Rgb; 3], String> {
+        Ok([
+            sigma(&self.alpha, "alpha", self.distance)?,
+            sigma(&self.beta, "beta", self.distance)?,
+            sigma(&self.gamma, "gamma", self.distance)?,
+        ])
+    }
+}
+
+/// A biaxial crystal's checks the fields cannot make alone: the keyword the error is at and what
+/// is wrong, or the orthonormal axes X, Y, Z.
+pub fn biaxial_axes(
+    ior: f32,
+    beta: f32,
+    gamma: f32,
+    x: (f32, f32, f32),
+    z: (f32, f32, f32),
+) -> Result<[glam::Vec3; 3], (&'static str, String)> {
+    if !(ior <= beta && beta <= gamma) {
+        return Err((
+            "beta",
+            format!(
+                "body.crystal: the indices must satisfy ior ≤ beta ≤ gamma (n_α ≤ n_β ≤ n_γ), \
+                 got {ior} / {beta} / {gamma}"
+            ),
+        ));
+    }
+    let xv = glam::Vec3::new(x.0, x.1, x.2).normalize();
+    let zv = glam::Vec3::new(z.0, z.1, z.2).normalize();
+    if xv.cross(zv).length_squared() < MIN_AXES_SIN2 {
+        return Err((
+            "z_axis",
+            format!(
+                "body.crystal.z_axis = {z:?} is within 5° of x_axis = {x:?}: the principal \
+                 axes must be at least 5° apart (z_axis is then made orthogonal to x_axis)"
+            ),
+        ));
+    }
+    let zv = (zv - xv * zv.dot(xv)).normalize();
+    Ok([xv, zv.cross(xv), zv])
+}
+
+impl super::map_compiler::Compiler<'_> {
+    /// Compiles a body's `crystal` (the body's keyword at `at`, its index `ior`); errors are
+    /// recorded at the offending keyword.
+    pub(super) fn crystal(
+        &mut self,
+        r: &super::GemRecipe,
+        desc: &CrystalDesc,
+        ior: f32,
+        at: Option<usize>,
+    ) -> Option<crate::scene::body::Crystal> {
+        use crate::scene::body::{Crystal, Indices};
+        let from = at.unwrap_or(0);
+        let fail = |errors: &mut Vec<_>, key: &str, msg: String| {
+            let pos = r.source.find_from(from, &[key, ":"]).or(at);
+            errors.push(r.source.error(pos, msg));
+        };
+        match desc {
+            CrystalDesc::Uniaxial {
+                ne,
+                axis,
+                pleochroism,
+            } => {
+                let (o, e) = match pleochroism.as_ref().map(|p| p.coefficients()) {
+                    None => (Rgb::ZERO, Rgb::ZERO),
+                    Some(Ok(s)) => s,
+                    Some(Err(m)) => {
+                        fail(&mut self.errors, "pleochroism", format!("body.crystal.{m}"));
+                        return None;
+                    }
+                };
+                Some(Crystal {
+                    indices: Indices::Uniaxial {
+                        ne: *ne,
+                        axis: glam::Vec3::new(axis.0, axis.1, axis.2).normalize(),
+                    },
+                    sigma: [o, e, Rgb::ZERO],
+                })
+            }
+            CrystalDesc::Biaxial {
+                beta,
+                gamma,
+                x_axis,
+                z_axis,
+                pleochroism,
+            } => {
+                let axes = match biaxial_axes(ior, *beta, *gamma, *x_axis, *z_axis) {
+                    Ok(a) => a,
+                    Err((key, m)) => {
+                        fail(&mut self.errors, key, m);
+                        return None;
+                    }
+                };
+                let sigma = match pleochroism.as_ref().map(|p| p.coefficients()) {
+                    None => [Rgb::ZERO; 3],
+                    Some(Ok(s)) => s,
+                    Some(Err(m)) => {
+                        fail(&mut self.errors, "pleochroism", format!("body.crystal.{m}"));
+                        return None;
+                    }
+                };
+                Some(Crystal {
+                    indices: Indices::Biaxial {
+                        beta: *beta,
+                        gamma: *gamma,
+                        axes,
+                    },
+                    sigma,
+                })
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn biaxial_axes_are_orthonormal_and_checked() {
+        let [x, y, z] = biaxial_axes(1.5, 1.55, 1.6, (2.0, 0.0, 0.0), (0.3, 0.0, 1.0)).unwrap();
+        assert!((x - glam::Vec3::X).length() < 1e-6 && (z - glam::Vec3::Z).length() < 1e-6);
+        assert!((y - glam::Vec3::Y).length() < 1e-6, "{y}");
+        let (at, msg) = biaxial_axes(1.5, 1.45, 1.6, (1.0, 0.0, 0.0), (0.0, 0.0, 1.0)).unwrap_err();
+        assert!(at == "beta" && msg.contains("ior ≤ beta ≤ gamma"), "{msg}");
+        assert!(biaxial_axes(1.5, 1.7, 1.6, (1.0, 0.0, 0.0), (0.0, 0.0, 1.0)).is_err());
+        let (at, msg) =
+            biaxial_axes(1.5, 1.55, 1.6, (1.0, 0.0, 0.0), (1.0, 0.05, 0.0)).unwrap_err();
+        assert!(at == "z_axis" && msg.contains("within 5°"), "{msg}");
+    }
+
+    #[test]
+    fn trichroic_colours_become_coefficients() {
+        let t = TrichroismDesc {
+            alpha: ColorDesc::Rgb(0.5, 0.5, 0.5),
+            beta: ColorDesc::Rgb(1.0, 1.0, 1.0),
+            gamma: ColorDesc::Rgb(0.25, 0.5, 1.0),
+            distance: 2.0,
+        };
+        let [a, b, g] = t.coefficients().unwrap();
+        assert!((a.0[0] - 0.5f32.ln().abs() / 2.0).abs() < 1e-6);
+        assert_eq!(b.0, [0.0; 3]);
+        assert!((g.0[0] - 4.0f32.ln() / 2.0).abs() < 1e-6 && g.0[2] == 0.0);
+        let bad = TrichroismDesc {
+            gamma: ColorDesc::Rgb(0.0, 0.5, 1.0),
+            ..t
+        };
+        assert!(bad.coefficients().unwrap_err().contains("pleochroism.gamma"));
+    }
+}
