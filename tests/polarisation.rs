@@ -291,7 +291,10 @@ fn biaxial_spheres_in_a_white_furnace() {
         ));
         let (got, se) = mean(&s);
         eprintln!("biaxial sphere {ior}/{beta}/{gamma}: {got:.5} ± {se:.5}");
-        assert!((got - 1.0).abs() < 0.01 + 5.0 * se, "{ior}/{beta}/{gamma}: {got} ± {se}");
+        assert!(
+            (got - 1.0).abs() < 0.01 + 5.0 * se,
+            "{ior}/{beta}/{gamma}: {got} ± {se}"
+        );
     }
 }
 
@@ -317,7 +320,10 @@ fn a_biaxial_plate_blinks_between_crossed_polars() {
         let want = bright * (2.0 * phi.to_radians()).sin().powi(2);
         let tol = 5.0 * (se * se + (se45 * want / bright).powi(2)).sqrt() + 1e-6;
         eprintln!("φ {phi}°: {got:.5} ± {se:.5} (sin² 2φ × the 45° image: {want:.5})");
-        assert!((got - want).abs() <= tol, "φ {phi}°: {got} vs {want} ± {tol}");
+        assert!(
+            (got - want).abs() <= tol,
+            "φ {phi}°: {got} vs {want} ± {tol}"
+        );
     }
 }
 
@@ -466,8 +472,16 @@ fn the_dichroscope_shows_a_trichroic_crystals_three_colours() {
     let (w, h) = (48usize, 24usize);
     // (x_axis, z_axis, [left, right] as (τ, n)).
     let views = [
-        ("(1.0, 0.0, 0.0)", "(0.0, 1.0, 0.0)", [(0.8f64, 1.620f64), (0.5, 1.621)]),
-        ("(0.0, 1.0, 0.0)", "(1.0, 0.0, 0.0)", [(0.2, 1.622), (0.5, 1.621)]),
+        (
+            "(1.0, 0.0, 0.0)",
+            "(0.0, 1.0, 0.0)",
+            [(0.8f64, 1.620f64), (0.5, 1.621)],
+        ),
+        (
+            "(0.0, 1.0, 0.0)",
+            "(1.0, 0.0, 0.0)",
+            [(0.2, 1.622), (0.5, 1.621)],
+        ),
     ];
     for (x_axis, z_axis, windows) in views {
         let s = compile(&format!(
@@ -498,7 +512,8 @@ fn the_dichroscope_shows_a_trichroic_crystals_three_colours() {
                 .collect();
             let count = v.len() as f64;
             let m = v.iter().sum::<f64>() / count;
-            let se = (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (count - 1.0) / count).sqrt();
+            let se =
+                (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (count - 1.0) / count).sqrt();
             let want = 0.5 * t2 * (tau + tau.powi(3) * r * r);
             eprintln!("{x_axis} half {half}: {m:.5} ± {se:.5} (closed form {want:.5})");
             assert!(

@@ -122,9 +122,18 @@ impl Biaxial {
             n: self.n.map(|n| 1.0 / n),
             axes: self.axes,
         };
-        let [a, b] = dual.indices(ray).map(|v| dual.ray(v * ray));
-        let miss = |s: DVec3| (self.ray(self.indices(s)[usize::from(slow)] * s) - ray).length_squared();
-        if miss(a) <= miss(b) { a } else { b }
+        let v = dual.indices(ray);
+        let miss =
+            |s: DVec3| (self.ray(self.indices(s)[usize::from(slow)] * s) - ray).length_squared();
+        // The sheet that pairs with `slow` away from the optic axes first (the slow wave has the
+        // smaller ray velocity); the other only if that one's ray misses.
+        let first = dual.ray(v[usize::from(!slow)] * ray);
+        let m = miss(first);
+        if m <= 1e-24 {
+            return first;
+        }
+        let second = dual.ray(v[usize::from(slow)] * ray);
+        if m <= miss(second) { first } else { second }
     }
 
     /// The rows of `M = k kᵀ − (k·k) I + ε`, whose null vectors are the fields of a wave with
@@ -192,7 +201,9 @@ impl Biaxial {
     /// The unit displacement `D = ε E` (across the wave normal) of a real field `e`.
     pub fn displacement(&self, e: DVec3) -> DVec3 {
         let eps = self.eps();
-        let d: DVec3 = (0..3).map(|i| eps[i] * self.axes[i].dot(e) * self.axes[i]).sum();
+        let d: DVec3 = (0..3)
+            .map(|i| eps[i] * self.axes[i].dot(e) * self.axes[i])
+            .sum();
         d.normalize_or_zero()
     }
 
@@ -398,6 +409,11 @@ mod tests {
             }
             // |t| < n_α: all four waves propagate.
             assert!(roots.iter().all(|u| u.im.abs() < 1e-9), "{roots:?}");
+            // The reversed problem's roots are these negated (F is even in k).
+            let back = b.normal_components(-t, m).unwrap();
+            for u in roots {
+                assert!(back.iter().any(|v| (*v + u).norm() < 1e-10), "{u} {back:?}");
+            }
         }
     }
 
@@ -424,7 +440,11 @@ mod tests {
                 (b.crystal.ray(d, mode).z > 1e-6).then_some(Incident::Inside { dir: d, mode })
             } else {
                 d.z = -d.z.abs();
-                let mode = if rng.uniform() < 0.5 { Mode::S } else { Mode::P };
+                let mode = if rng.uniform() < 0.5 {
+                    Mode::S
+                } else {
+                    Mode::P
+                };
                 Some(Incident::Outside { dir: d, mode })
             }
         }
@@ -440,20 +460,42 @@ mod tests {
                 let axes = random_axes(&mut rng);
                 let positive = i % 2 == 0;
                 let (n, u) = if positive {
-                    ([1.5, 1.5, 1.7], Uniaxial { no: 1.5, ne: 1.7, axis: axes[2] })
+                    (
+                        [1.5, 1.5, 1.7],
+                        Uniaxial {
+                            no: 1.5,
+                            ne: 1.7,
+                            axis: axes[2],
+                        },
+                    )
                 } else {
-                    ([1.5, 1.7, 1.7], Uniaxial { no: 1.7, ne: 1.5, axis: axes[0] })
+                    (
+                        [1.5, 1.7, 1.7],
+                        Uniaxial {
+                            no: 1.7,
+                            ne: 1.5,
+                            axis: axes[0],
+                        },
+                    )
                 };
                 let bx = boundary(n, axes);
-                let bu = Boundary { crystal: Optics::Uniaxial(u), ..bx };
+                let bu = Boundary {
+                    crystal: Optics::Uniaxial(u),
+                    ..bx
+                };
                 let map = |m: Mode| match (m, positive) {
                     (Mode::Fast, true) | (Mode::Slow, false) => Mode::O,
                     (Mode::Fast, false) | (Mode::Slow, true) => Mode::E,
                     (m, _) => m,
                 };
-                let Some(inc) = incident(&bx, &mut rng, i % 4 >= 2) else { continue };
+                let Some(inc) = incident(&bx, &mut rng, i % 4 >= 2) else {
+                    continue;
+                };
                 let inc_u = match inc {
-                    Incident::Inside { dir, mode } => Incident::Inside { dir, mode: map(mode) },
+                    Incident::Inside { dir, mode } => Incident::Inside {
+                        dir,
+                        mode: map(mode),
+                    },
                     o => o,
                 };
                 let (Some(x), Some(y)) = (bx.solve(inc, DVec3::X), bu.solve(inc_u, DVec3::X))
@@ -485,8 +527,12 @@ mod tests {
             for i in 0..4000 {
                 let n = if i % 2 == 0 { IOLITE } else { STRONG };
                 let b = boundary(n, random_axes(&mut rng));
-                let Some(inc) = incident(&b, &mut rng, i % 4 >= 2) else { continue };
-                let Some(out) = b.solve(inc, DVec3::X) else { continue };
+                let Some(inc) = incident(&b, &mut rng, i % 4 >= 2) else {
+                    continue;
+                };
+                let Some(out) = b.solve(inc, DVec3::X) else {
+                    continue;
+                };
                 solved += 1;
                 let total: f64 = out.iter().map(|o| o.power).sum();
                 assert!((total - 1.0).abs() < 1e-7, "{inc:?}: {total} {out:?}");
@@ -508,7 +554,9 @@ mod tests {
                 d.z = -d.z.abs().max(0.05);
                 let d = d.normalize();
                 for mode in [Mode::S, Mode::P] {
-                    let fwd = b.solve(Incident::Outside { dir: d, mode }, DVec3::X).unwrap();
+                    let fwd = b
+                        .solve(Incident::Outside { dir: d, mode }, DVec3::X)
+                        .unwrap();
                     for j in [2, 3] {
                         let w = fwd[j].wave;
                         if !w.propagating() || fwd[j].power < 1e-9 {
@@ -516,7 +564,10 @@ mod tests {
                         }
                         let back = b
                             .solve(
-                                Incident::Inside { dir: -w.direction(), mode: w.mode },
+                                Incident::Inside {
+                                    dir: -w.direction(),
+                                    mode: w.mode,
+                                },
                                 DVec3::X,
                             )
                             .unwrap();

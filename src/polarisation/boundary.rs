@@ -183,7 +183,14 @@ impl Boundary {
 
     /// The crystal's wave of `mode` with tangential `t`, going away from the boundary (down,
     /// decaying into the crystal when evanescent) or toward it (`up`, propagating).
-    fn crystal_wave(&self, x: &super::uniaxial::Uniaxial, t: DVec3, mode: Mode, up: bool, s: DVec3) -> Wave {
+    fn crystal_wave(
+        &self,
+        x: &super::uniaxial::Uniaxial,
+        t: DVec3,
+        mode: Mode,
+        up: bool,
+        s: DVec3,
+    ) -> Wave {
         let (n, c) = (self.normal, x.axis);
         let (io, ie) = (1.0 / (x.no * x.no), 1.0 / (x.ne * x.ne));
         // The normal component u of k = t + u n.
@@ -232,8 +239,19 @@ impl Boundary {
     /// power shares; `reference` fixes the s axis at normal incidence. `None` if the problem is
     /// singular (a grazing wave).
     pub fn solve(&self, incident: Incident, reference: DVec3) -> Option<[Outgoing; 4]> {
+        self.solve_in(incident, reference, &mut Roots::default())
+    }
+
+    /// [`Boundary::solve`] reusing the crystal's roots of an earlier solve of the same event
+    /// (`roots`, updated).
+    pub fn solve_in(
+        &self,
+        incident: Incident,
+        reference: DVec3,
+        roots: &mut Roots,
+    ) -> Option<[Outgoing; 4]> {
         let (t, s, index) = self.tangential(incident, reference);
-        let out = self.outgoing(t, s)?;
+        let out = self.outgoing(t, s, roots)?;
         self.amplitudes(incident, index, t, s, &out)
     }
 
@@ -241,13 +259,20 @@ impl Boundary {
     /// crystal), `[s, p]`: the outgoing waves, which depend only on the tangential wave vector,
     /// found once.
     pub fn solve_sp(&self, dir: DVec3, reference: DVec3) -> Option<[[Outgoing; 4]; 2]> {
+        self.solve_sp_in(dir, reference, &mut Roots::default())
+    }
+
+    /// [`Boundary::solve_sp`] reusing and updating `roots` as [`Boundary::solve_in`].
+    pub fn solve_sp_in(
+        &self,
+        dir: DVec3,
+        reference: DVec3,
+        roots: &mut Roots,
+    ) -> Option<[[Outgoing; 4]; 2]> {
         let inc = |mode| Incident::Outside { dir, mode };
         let (t, s, index) = self.tangential(inc(Mode::S), reference);
-        let out = self.outgoing(t, s)?;
-        Some([
-            self.amplitudes(inc(Mode::S), index, t, s, &out)?,
-            self.amplitudes(inc(Mode::P), index, t, s, &out)?,
-        ])
+        let out = self.outgoing(t, s, roots)?;
+        self.amplitudes_of([inc(Mode::S), inc(Mode::P)], index, t, s, &out)
     }
 
     /// The tangential wave vector of `incident`, the s axis and the incident wave's index.
@@ -266,13 +291,16 @@ impl Boundary {
 
     /// The four waves leaving the boundary with tangential `t` (s axis `s`): `S`, `P` on the
     /// isotropic side, then the crystal's two.
-    fn outgoing(&self, t: DVec3, s: DVec3) -> Option<[Wave; 4]> {
+    fn outgoing(&self, t: DVec3, s: DVec3, roots: &mut Roots) -> Option<[Wave; 4]> {
         let [c0, c1] = match &self.crystal {
             Optics::Uniaxial(x) => [
                 self.crystal_wave(x, t, Mode::O, false, s),
                 self.crystal_wave(x, t, Mode::E, false, s),
             ],
-            Optics::Biaxial(x) => self.biaxial_down(x, t, s)?,
+            Optics::Biaxial(x) => {
+                let u = roots.of(x, t, self.normal)?;
+                self.biaxial_down(x, t, s, u)?
+            }
         };
         Some([
             self.isotropic(t, s, Mode::S, true),
@@ -291,8 +319,23 @@ impl Boundary {
         s: DVec3,
         out: &[Wave; 4],
     ) -> Option<[Outgoing; 4]> {
+        self.amplitudes_of([incident], index, t, s, out)
+            .map(|[o]| o)
+    }
+
+    /// [`Boundary::amplitudes`] of `R` incident waves with the same tangential wave vector: one
+    /// elimination of the boundary's matrix with `R` right-hand sides (each column's numbers are
+    /// those of its own elimination); `None` if any of them fails.
+    fn amplitudes_of<const R: usize>(
+        &self,
+        incidents: [Incident; R],
+        index: f64,
+        t: DVec3,
+        s: DVec3,
+        out: &[Wave; 4],
+    ) -> Option<[[Outgoing; 4]; R]> {
         let n = self.normal;
-        let inc = match (incident, &self.crystal) {
+        let inc = incidents.map(|incident| match (incident, &self.crystal) {
             (Incident::Outside { mode, .. }, _) => self.isotropic(t, s, mode, false),
             (Incident::Inside { mode, .. }, Optics::Uniaxial(x)) => {
                 self.crystal_wave(x, t, mode, true, s)
@@ -301,43 +344,48 @@ impl Boundary {
                 let k = biaxial::complex(index * dir);
                 Wave::new(mode, k, x.field(k, s, mode == Mode::Slow))
             }
-        };
+        });
         // Tangential E and H continuous: Σ(isotropic side) = Σ(crystal side). Unknowns: the four
         // outgoing amplitudes; the incident wave sits on its own side.
         let t1 = cv(s);
         let t2 = cv(n.cross(s));
         let rows = |w: &Wave| [dot(w.e, t1), dot(w.e, t2), dot(w.h, t1), dot(w.h, t2)];
-        let mut a = [[C::from(0.0); 5]; 4];
+        let mut a = [[C::from(0.0); 4]; 4];
         for (j, w) in out.iter().enumerate() {
             let sign = if j < 2 { 1.0 } else { -1.0 };
             for (i, v) in rows(w).into_iter().enumerate() {
                 a[i][j] = v * sign;
             }
         }
-        let inc_sign = match incident {
-            Incident::Outside { .. } => -1.0,
-            Incident::Inside { .. } => 1.0,
-        };
-        for (i, v) in rows(&inc).into_iter().enumerate() {
-            a[i][4] = v * inc_sign;
+        let mut b = [[C::from(0.0); R]; 4];
+        for (k, (incident, w)) in incidents.iter().zip(&inc).enumerate() {
+            let inc_sign = match incident {
+                Incident::Outside { .. } => -1.0,
+                Incident::Inside { .. } => 1.0,
+            };
+            for (i, v) in rows(w).into_iter().enumerate() {
+                b[i][k] = v * inc_sign;
+            }
         }
-        let x = solve4(a)?;
-        let flux_in = inc.flux(n).abs();
-        if !(flux_in > 0.0) {
+        let x = solve4(a, b)?;
+        let flux_in = inc.map(|w| w.flux(n).abs());
+        if !flux_in.iter().all(|f| *f > 0.0) {
             return None;
         }
-        Some(std::array::from_fn(|j| {
-            let w = out[j];
-            let power = if w.propagating() {
-                x[j].norm_sqr() * w.flux(n).abs() / flux_in
-            } else {
-                0.0
-            };
-            Outgoing {
-                wave: w,
-                amplitude: x[j],
-                power,
-            }
+        Some(std::array::from_fn(|k| {
+            std::array::from_fn(|j| {
+                let w = out[j];
+                let power = if w.propagating() {
+                    x[k][j].norm_sqr() * w.flux(n).abs() / flux_in[k]
+                } else {
+                    0.0
+                };
+                Outgoing {
+                    wave: w,
+                    amplitude: x[k][j],
+                    power,
+                }
+            })
         }))
     }
 }
@@ -350,9 +398,8 @@ impl Boundary {
     /// constant `t` misses the inner sheet first); two roots within 1e-6 are one wave along an
     /// optic axis, given two orthogonal fields. `None` if the roots do not split two and two (a
     /// wave grazing the boundary).
-    fn biaxial_down(&self, x: &Biaxial, t: DVec3, s: DVec3) -> Option<[Wave; 2]> {
+    fn biaxial_down(&self, x: &Biaxial, t: DVec3, s: DVec3, roots: [C; 4]) -> Option<[Wave; 2]> {
         let n = self.normal;
-        let roots = x.normal_components(t, n)?;
         let mut down = [(C::from(0.0), false); 2];
         let mut count = 0;
         for u in roots {
@@ -382,7 +429,7 @@ impl Boundary {
             (true, false) => (b, a),
             _ => (a, b),
         };
-        let degenerate = ra && rb && (fast - slow).norm() <= 1e-6 * (1.0 + fast.norm());
+        let degenerate = ra && rb && (fast - slow).norm_sqr() <= 1e-12 * (1.0 + fast.norm_sqr());
         let (fast, slow) = if degenerate {
             let mid = 0.5 * (fast + slow);
             (mid, mid)
@@ -399,26 +446,61 @@ impl Boundary {
     }
 }
 
-/// Gaussian elimination with partial pivoting on an augmented 4 × 5 system.
-fn solve4(mut a: [[C; 5]; 4]) -> Option<[C; 4]> {
+/// A biaxial crystal's quartic roots (the normal components of its four waves) from the last
+/// solve of one boundary event, kept for the next solve of the same event: a camera path's
+/// physical problem has the opposite tangential wave vector of its adjoint one (the reversed
+/// waves), whose roots are the same negated (`F(−t + u m) = F(t − u m)`: Fresnel's equation is
+/// even in `k`). Local to one event, so a render's numbers never depend on what another path
+/// solved.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Roots(Option<(DVec3, [C; 4])>);
+
+impl Roots {
+    /// The roots for tangential `t` on a boundary with normal `m`: the kept ones for `t` or,
+    /// negated, for `−t` (to 1e-9 of `|t|`: a reversed wave's tangential component, formed from
+    /// its index along its direction, repeats the adjoint's only to the roots' accuracy), else
+    /// solved; kept for the next call.
+    fn of(&mut self, x: &Biaxial, t: DVec3, m: DVec3) -> Option<[C; 4]> {
+        let tol = 1e-18 * (1.0 + t.length_squared());
+        let roots = match self.0 {
+            Some((t0, r)) if (t - t0).length_squared() <= tol => r,
+            Some((t0, r)) if (t + t0).length_squared() <= tol => r.map(|u| -u),
+            _ => x.normal_components(t, m)?,
+        };
+        self.0 = Some((t, roots));
+        Some(roots)
+    }
+}
+
+/// Gaussian elimination with partial pivoting of the 4 × 4 system `a` with `R` right-hand sides
+/// (the columns of `b`); the solutions, one per column.
+fn solve4<const R: usize>(mut a: [[C; 4]; 4], mut b: [[C; R]; 4]) -> Option<[[C; 4]; R]> {
     for col in 0..4 {
         let p = (col..4).max_by(|&i, &j| a[i][col].norm().total_cmp(&a[j][col].norm()))?;
         if !(a[p][col].norm() > 1e-14) {
             return None;
         }
         a.swap(col, p);
-        let pivot = a[col];
-        for (r, row) in a.iter_mut().enumerate() {
-            if r != col {
-                let f = row[col] / pivot[col];
-                for (x, v) in row.iter_mut().zip(pivot).skip(col) {
-                    *x -= f * v;
-                }
+        b.swap(col, p);
+        let (pivot, pb) = (a[col], b[col]);
+        for (row, rb) in a
+            .iter_mut()
+            .zip(b.iter_mut())
+            .enumerate()
+            .filter(|(r, _)| *r != col)
+            .map(|(_, x)| x)
+        {
+            let f = row[col] / pivot[col];
+            for (x, v) in row.iter_mut().zip(pivot).skip(col) {
+                *x -= f * v;
+            }
+            for (x, v) in rb.iter_mut().zip(pb) {
+                *x -= f * v;
             }
         }
     }
-    let x: [C; 4] = std::array::from_fn(|i| a[i][4] / a[i][i]);
-    x.iter().all(|c| c.is_finite()).then_some(x)
+    let x: [[C; 4]; R] = std::array::from_fn(|k| std::array::from_fn(|i| b[i][k] / a[i][i]));
+    x.iter().flatten().all(|c| c.is_finite()).then_some(x)
 }
 
 #[cfg(test)]

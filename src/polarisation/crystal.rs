@@ -20,7 +20,7 @@
 //! waves' phase indices; in an anisotropic medium the exact invariant also involves the walk-off
 //! angle, which this leaves out (an error of order `ρ²`, below 1 % for calcite's 6°).
 
-use super::boundary::{Boundary, Incident, Mode, Outgoing};
+use super::boundary::{Boundary, Incident, Mode, Outgoing, Roots};
 use super::optics::Optics;
 use super::transport::PathPolarisation;
 use glam::DVec3;
@@ -116,7 +116,8 @@ pub fn from_outside(
     let reference = p.x.as_dvec3();
     let dir = -wo;
     // Adjoint: unpolarised light sent in along the path.
-    let [s_in, p_in] = b.solve_sp(dir, reference)?;
+    let mut roots = Roots::default();
+    let [s_in, p_in] = b.solve_sp_in(dir, reference, &mut roots)?;
     let share = |j: usize| 0.5 * (s_in[j].power + p_in[j].power);
     let shares = [share(0) + share(1), share(2), share(3)];
     let choice = pick(&shares, u)?;
@@ -129,7 +130,7 @@ pub fn from_outside(
         // Reflection: the physical light arrived along −wi (mirror of wo); its Jones matrix
         // (columns incident s, p) is the solve for that direction, whose s axis is this one.
         let wi = 2.0 * n * n.dot(wo) - wo;
-        let [rs, rp] = b.solve_sp(-wi, reference)?;
+        let [rs, rp] = b.solve_sp_in(-wi, reference, &mut roots)?;
         let jones = [
             [rs[0].amplitude, rp[0].amplitude],
             [rs[1].amplitude, rp[1].amplitude],
@@ -163,12 +164,13 @@ pub fn from_outside(
     };
     let k_down = adj.wave.direction();
     let ray_down = ray_of(b, &adj);
-    let phys = b.solve(
+    let phys = b.solve_in(
         Incident::Inside {
             dir: -k_down,
             mode: adj.wave.mode,
         },
         reference,
+        &mut roots,
     )?;
     let t_exit = phys[0].power + phys[1].power;
     let st = stokes(phys[0].amplitude, phys[1].amplitude);
@@ -207,7 +209,8 @@ pub fn from_inside(
     };
     // The light's wave travels down along −dir; the adjoint sends it back up along dir.
     let k_up = b.crystal.wave_of_ray(dir, mode);
-    let adj = b.solve(Incident::Inside { dir: k_up, mode }, reference)?;
+    let mut roots = Roots::default();
+    let adj = b.solve_in(Incident::Inside { dir: k_up, mode }, reference, &mut roots)?;
     let shares = [adj[0].power + adj[1].power, adj[2].power, adj[3].power];
     let choice = pick(&shares, u.1)?;
     let prob = shares[choice] / shares.iter().sum::<f64>();
@@ -219,7 +222,7 @@ pub fn from_inside(
         } else {
             adj[1].wave.direction()
         };
-        let [s_in, p_in] = b.solve_sp(-wi, reference)?;
+        let [s_in, p_in] = b.solve_sp_in(-wi, reference, &mut roots)?;
         let j = b.crystal.slot(mode);
         let (a, pa) = (s_in[j].amplitude, s_in[j].power);
         let (bb, pb) = (p_in[j].amplitude, p_in[j].power);
@@ -264,12 +267,13 @@ pub fn from_inside(
     // Reflected from wave k: the adjoint's reflected wave, reversed, is the light's.
     let o = adj[choice + 1];
     let ray = ray_of(b, &o);
-    let phys = b.solve(
+    let phys = b.solve_in(
         Incident::Inside {
             dir: -o.wave.direction(),
             mode: o.wave.mode,
         },
         reference,
+        &mut roots,
     )?;
     let r = phys[b.crystal.slot(mode)].power;
     let index_k = DVec3::new(o.wave.k[0].re, o.wave.k[1].re, o.wave.k[2].re).length();

@@ -87,9 +87,7 @@ impl Optics {
                 let reference = ray.any_orthonormal_vector();
                 let e = x.field(complex(k), reference, mode == Mode::Slow);
                 let e = DVec3::new(e[0].re, e[1].re, e[2].re);
-                (e - ray * e.dot(ray))
-                    .try_normalize()
-                    .unwrap_or(reference)
+                (e - ray * e.dot(ray)).try_normalize().unwrap_or(reference)
             }
         }
     }

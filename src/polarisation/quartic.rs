@@ -94,7 +94,13 @@ mod tests {
     /// pairs or are real, so the coefficients are real).
     fn from_roots(r: [C; 4]) -> [f64; 4] {
         // Expand (z − r0)(z − r1)(z − r2)(z − r3).
-        let mut p = [C::from(1.0), C::from(0.0), C::from(0.0), C::from(0.0), C::from(0.0)];
+        let mut p = [
+            C::from(1.0),
+            C::from(0.0),
+            C::from(0.0),
+            C::from(0.0),
+            C::from(0.0),
+        ];
         for (k, ri) in r.iter().enumerate() {
             for j in (1..=k + 1).rev() {
                 p[j] = p[j] - *ri * p[j - 1];

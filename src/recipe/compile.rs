@@ -327,7 +327,11 @@ impl Compiler<'_> {
             },
         };
         let (platelets, platelet_materials) = self.platelets(desc, body_index, at.unwrap_or(0))?;
-        let crystal = match desc.crystal.as_ref().map(|c| self.crystal(r, c, desc.ior, at)) {
+        let crystal = match desc
+            .crystal
+            .as_ref()
+            .map(|c| self.crystal(r, c, desc.ior, at))
+        {
             None => None,
             Some(Some(c)) => Some(c),
             Some(None) => return None,

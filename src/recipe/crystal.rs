@@ -277,6 +277,10 @@ mod tests {
             gamma: ColorDesc::Rgb(0.0, 0.5, 1.0),
             ..t
         };
-        assert!(bad.coefficients().unwrap_err().contains("pleochroism.gamma"));
+        assert!(
+            bad.coefficients()
+                .unwrap_err()
+                .contains("pleochroism.gamma")
+        );
     }
 }

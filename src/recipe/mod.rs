@@ -12,8 +12,8 @@
 mod ranged;
 pub mod body;
 pub mod color;
-pub mod crystal;
 mod compile;
+pub mod crystal;
 pub mod cut;
 pub mod dispersion;
 mod faceted;

@@ -8,9 +8,9 @@ use crate::bsdf::{Bsdf, BsdfSample, Lobe, LobeKind, Scatter};
 use crate::color::Rgb;
 use crate::polarisation::boundary::{Boundary, Mode};
 use crate::polarisation::crystal;
+use crate::polarisation::optics::Optics;
 use crate::polarisation::stokes::{ROWS, StokesRows};
 use crate::polarisation::transport::{InterfaceEvent, MAX_CHANNELS, PathPolarisation};
-use crate::polarisation::optics::Optics;
 use crate::polarisation::uniaxial::Uniaxial;
 use crate::spectrum::Spectral;
 use glam::Vec3;
@@ -157,8 +157,16 @@ where
     // The normal pointing out of the stone.
     let facing = if n.dot(wo) > 0.0 { n } else { -n };
     let normal = if outside { facing } else { -facing };
+    let crystal_optics = crystal.at(no);
+    // A biaxial boundary's normal made unit in f64 (an f32 normal is unit to 6e-8 only), so
+    // that a reversed wave's tangential component repeats the adjoint's and the event solves
+    // the crystal's quartic once (`boundary::Roots`); the uniaxial closed forms keep theirs.
+    let normal = match crystal_optics {
+        Optics::Biaxial(_) => normal.normalize(),
+        Optics::Uniaxial(_) => normal,
+    };
     let b = Boundary {
-        crystal: crystal.at(no),
+        crystal: crystal_optics,
         n1: 1.0,
         normal,
     };
@@ -260,7 +268,9 @@ pub(super) fn pleochroic_transmittance<S: Spectral>(
             crystal.sigma[0] * c2 + crystal.sigma[1] * (1.0 - c2)
         }
         (_, Optics::Biaxial(_)) => {
-            let w = optics.absorption_weights(ray, mode).unwrap_or([1.0 / 3.0; 3]);
+            let w = optics
+                .absorption_weights(ray, mode)
+                .unwrap_or([1.0 / 3.0; 3]);
             crystal.sigma[0] * (w[0] as f32)
                 + crystal.sigma[1] * (w[1] as f32)
                 + crystal.sigma[2] * (w[2] as f32)
