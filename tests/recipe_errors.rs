@@ -216,6 +216,7 @@ fn rows() -> Vec<Row> {
         row("biaxial_gamma_five", (3, 40), &["crystal.gamma = 5", "1.0001 ..= 4"], gem(" body: (ior: 1.544,\n  crystal: Biaxial(beta: 1.548, gamma: 5.0, x_axis: (1.0, 0.0, 0.0), z_axis: (0.0, 0.0, 1.0))),\n surface: Body")),
         row("biaxial_axes_parallel", (3, 72), &["body.crystal.z_axis", "within 5° of x_axis", "at least 5° apart"], gem(" body: (ior: 1.544,\n  crystal: Biaxial(beta: 1.548, gamma: 1.553, x_axis: (1.0, 0.0, 0.0), z_axis: (1.0, 0.05, 0.0))),\n surface: Body")),
         row("trichroism_black", (4, 4), &["body.crystal.pleochroism.gamma", "0 <..= 1"], gem(" body: (ior: 1.544,\n  crystal: Biaxial(beta: 1.548, gamma: 1.553, x_axis: (1.0, 0.0, 0.0), z_axis: (0.0, 0.0, 1.0),\n   pleochroism: (alpha: Gray(0.5), beta: Gray(0.5), gamma: Gray(0.0), distance: 1.0))),\n surface: Body")),
+        row("thin_section_unit_zero", (3, 79), &["thin_section.unit_nm = 0", "0 <.. 10000000"], gem(" body: (ior: 1.544,\n  crystal: Uniaxial(ne: 1.553, axis: (0.0, 1.0, 0.0), thin_section: (unit_nm: 0.0))),\n surface: Body")),
         row("analyser_400", (4, 13), &["analyser = 400", "-360 ..= 360"], stage("  analyser: 400.0,")),
         row("polariscope_rotation_500", (4, 33), &["rotation = 500", "-360 ..= 360"], stage("  preset: Polariscope(rotation: 500.0),")),
         row("dichroscope_rotation_minus_720", (4, 33), &["rotation = -720", "-360 ..= 360"], stage("  preset: Dichroscope(rotation: -720.0),")),

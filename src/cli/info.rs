@@ -208,6 +208,13 @@ pub fn describe(recipe: &GemRecipe, scene: &Scene, points: u32) -> String {
                         .collect();
                     format!("; pleochroic {} per object unit", parts.join(", "))
                 };
+                let absorbs = |names: &[&str]| match c.thin_nm {
+                    None => absorbs(names),
+                    Some(nm) => format!(
+                        "{}; thin section, {nm} nm per object unit: coherent, interference colours",
+                        absorbs(names)
+                    ),
+                };
                 match c.indices {
                     crate::scene::body::Indices::Uniaxial { ne, axis } => format!(
                         "ω {ior}, ε {ne} (uniaxial, axis {:.3?}{})",

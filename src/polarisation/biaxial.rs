@@ -16,12 +16,10 @@
 //! ([`super::quartic`]). The ray — the direction energy travels — is the index surface's normal
 //! `∇F`, equal to the Poynting vector `E × (k × E)`.
 
+use super::cvec::{CVec, cross as ccross, cv as complex, dot as cdot, norm as cnorm};
 use super::quartic;
 use glam::DVec3;
 use num_complex::Complex64 as C;
-
-/// A complex 3-vector (bilinear products, as in [`super::boundary`]).
-pub type CVec = [C; 3];
 
 /// A biaxial crystal at one wavelength.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -35,27 +33,6 @@ pub struct Biaxial {
 /// Components of `v` along the axes (complex).
 fn along(axes: &[DVec3; 3], v: CVec) -> CVec {
     axes.map(|a| v[0] * a.x + v[1] * a.y + v[2] * a.z)
-}
-
-fn cdot(a: CVec, b: CVec) -> C {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn ccross(a: CVec, b: CVec) -> CVec {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn cnorm(a: CVec) -> f64 {
-    a.iter().map(|c| c.norm_sqr()).sum::<f64>().sqrt()
-}
-
-/// A real vector as a complex one.
-pub fn complex(v: DVec3) -> CVec {
-    [C::from(v.x), C::from(v.y), C::from(v.z)]
 }
 
 impl Biaxial {
@@ -262,6 +239,32 @@ impl Biaxial {
     }
 }
 
+/// A biaxial crystal's quartic roots (the normal components of its four waves) from the last
+/// solve of one boundary event, kept for the next solve of the same event: a camera path's
+/// physical problem has the opposite tangential wave vector of its adjoint one (the reversed
+/// waves), whose roots are the same negated (`F(−t + u m) = F(t − u m)`: Fresnel's equation is
+/// even in `k`). Local to one event, so a render's numbers never depend on what another path
+/// solved.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Roots(Option<(DVec3, [C; 4])>);
+
+impl Roots {
+    /// The roots for tangential `t` on a boundary with normal `m`: the kept ones for `t` or,
+    /// negated, for `−t` (to 1e-9 of `|t|`: a reversed wave's tangential component, formed from
+    /// its index along its direction, repeats the adjoint's only to the roots' accuracy), else
+    /// solved; kept for the next call.
+    pub fn of(&mut self, x: &Biaxial, t: DVec3, m: DVec3) -> Option<[C; 4]> {
+        let tol = 1e-18 * (1.0 + t.length_squared());
+        let roots = match self.0 {
+            Some((t0, r)) if (t - t0).length_squared() <= tol => r,
+            Some((t0, r)) if (t + t0).length_squared() <= tol => r.map(|u| -u),
+            _ => x.normal_components(t, m)?,
+        };
+        self.0 = Some((t, roots));
+        Some(roots)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -414,176 +417,6 @@ mod tests {
             for u in roots {
                 assert!(back.iter().any(|v| (*v + u).norm() < 1e-10), "{u} {back:?}");
             }
-        }
-    }
-
-    mod boundary {
-        use super::*;
-        use crate::polarisation::boundary::{Boundary, Incident, Mode};
-        use crate::polarisation::optics::Optics;
-
-        fn boundary(n: [f64; 3], axes: [DVec3; 3]) -> Boundary {
-            Boundary {
-                crystal: Optics::Biaxial(Biaxial { n, axes }),
-                n1: 1.0,
-                normal: DVec3::Z,
-            }
-        }
-
-        /// An incident wave from outside (`S`/`P`) or inside (one of the crystal's waves whose
-        /// energy reaches the boundary), drawn at random.
-        fn incident(b: &Boundary, rng: &mut Rng, inside: bool) -> Option<Incident> {
-            let mut d = random_unit(rng);
-            if inside {
-                d.z = d.z.abs();
-                let mode = b.crystal.modes()[usize::from(rng.uniform() < 0.5)];
-                (b.crystal.ray(d, mode).z > 1e-6).then_some(Incident::Inside { dir: d, mode })
-            } else {
-                d.z = -d.z.abs();
-                let mode = if rng.uniform() < 0.5 {
-                    Mode::S
-                } else {
-                    Mode::P
-                };
-                Some(Incident::Outside { dir: d, mode })
-            }
-        }
-
-        /// With two equal indices the biaxial boundary is the uniaxial one: the same powers into
-        /// the same waves (fast = ordinary for a positive crystal, extraordinary for a negative
-        /// one), from outside and from inside, over random axes and directions.
-        #[test]
-        fn two_equal_indices_give_the_uniaxial_boundary() {
-            let mut rng = Rng::new(31);
-            let mut compared = 0;
-            for i in 0..2000 {
-                let axes = random_axes(&mut rng);
-                let positive = i % 2 == 0;
-                let (n, u) = if positive {
-                    (
-                        [1.5, 1.5, 1.7],
-                        Uniaxial {
-                            no: 1.5,
-                            ne: 1.7,
-                            axis: axes[2],
-                        },
-                    )
-                } else {
-                    (
-                        [1.5, 1.7, 1.7],
-                        Uniaxial {
-                            no: 1.7,
-                            ne: 1.5,
-                            axis: axes[0],
-                        },
-                    )
-                };
-                let bx = boundary(n, axes);
-                let bu = Boundary {
-                    crystal: Optics::Uniaxial(u),
-                    ..bx
-                };
-                let map = |m: Mode| match (m, positive) {
-                    (Mode::Fast, true) | (Mode::Slow, false) => Mode::O,
-                    (Mode::Fast, false) | (Mode::Slow, true) => Mode::E,
-                    (m, _) => m,
-                };
-                let Some(inc) = incident(&bx, &mut rng, i % 4 >= 2) else {
-                    continue;
-                };
-                let inc_u = match inc {
-                    Incident::Inside { dir, mode } => Incident::Inside {
-                        dir,
-                        mode: map(mode),
-                    },
-                    o => o,
-                };
-                let (Some(x), Some(y)) = (bx.solve(inc, DVec3::X), bu.solve(inc_u, DVec3::X))
-                else {
-                    continue;
-                };
-                for o in &x {
-                    let twin = y.iter().find(|w| w.wave.mode == map(o.wave.mode)).unwrap();
-                    assert!(
-                        (o.power - twin.power).abs() < 1e-7,
-                        "{inc:?} {:?}: {} vs {}",
-                        o.wave.mode,
-                        o.power,
-                        twin.power
-                    );
-                }
-                compared += 1;
-            }
-            assert!(compared > 1800, "{compared}");
-        }
-
-        /// Energy is conserved for every incident wave, crystal and axes, inside and out (total
-        /// internal reflection of either wave included), for iolite and a strongly biaxial
-        /// crystal.
-        #[test]
-        fn power_is_conserved() {
-            let mut rng = Rng::new(32);
-            let mut solved = 0;
-            for i in 0..4000 {
-                let n = if i % 2 == 0 { IOLITE } else { STRONG };
-                let b = boundary(n, random_axes(&mut rng));
-                let Some(inc) = incident(&b, &mut rng, i % 4 >= 2) else {
-                    continue;
-                };
-                let Some(out) = b.solve(inc, DVec3::X) else {
-                    continue;
-                };
-                solved += 1;
-                let total: f64 = out.iter().map(|o| o.power).sum();
-                assert!((total - 1.0).abs() < 1e-7, "{inc:?}: {total} {out:?}");
-                assert!(out.iter().all(|o| o.power >= -1e-12));
-            }
-            assert!(solved > 3500, "{solved}");
-        }
-
-        /// Reciprocity: what an s or p wave from outside sends into a crystal wave equals what
-        /// that wave, reversed, sends into the reversed s or p wave.
-        #[test]
-        fn transmission_is_reciprocal() {
-            let mut rng = Rng::new(33);
-            let mut checked = 0;
-            for i in 0..600 {
-                let n = if i % 2 == 0 { IOLITE } else { STRONG };
-                let b = boundary(n, random_axes(&mut rng));
-                let mut d = random_unit(&mut rng);
-                d.z = -d.z.abs().max(0.05);
-                let d = d.normalize();
-                for mode in [Mode::S, Mode::P] {
-                    let fwd = b
-                        .solve(Incident::Outside { dir: d, mode }, DVec3::X)
-                        .unwrap();
-                    for j in [2, 3] {
-                        let w = fwd[j].wave;
-                        if !w.propagating() || fwd[j].power < 1e-9 {
-                            continue;
-                        }
-                        let back = b
-                            .solve(
-                                Incident::Inside {
-                                    dir: -w.direction(),
-                                    mode: w.mode,
-                                },
-                                DVec3::X,
-                            )
-                            .unwrap();
-                        let k = if mode == Mode::S { 0 } else { 1 };
-                        assert!(
-                            (back[k].power - fwd[j].power).abs() < 1e-7,
-                            "{mode:?}→{:?}: {} vs {}",
-                            w.mode,
-                            fwd[j].power,
-                            back[k].power
-                        );
-                        checked += 1;
-                    }
-                }
-            }
-            assert!(checked > 2000, "{checked}");
         }
     }
 }

@@ -18,57 +18,12 @@
 //! conservation for random crystals, axes and directions, reciprocity, and a biaxial crystal with
 //! two equal indices against the uniaxial closed forms.
 
-use super::biaxial::{self, Biaxial};
+use super::biaxial::Roots;
+use super::cvec::{CVec, add, cross, cv, dot, norm, real, scale, solve4};
+pub use super::optics::Mode;
 use super::optics::Optics;
 use glam::DVec3;
 use num_complex::Complex64 as C;
-
-/// A complex 3-vector.
-type CVec = [C; 3];
-
-fn cv(v: DVec3) -> CVec {
-    [C::from(v.x), C::from(v.y), C::from(v.z)]
-}
-fn add(a: CVec, b: CVec) -> CVec {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-fn scale(a: CVec, s: C) -> CVec {
-    [a[0] * s, a[1] * s, a[2] * s]
-}
-/// The bilinear (not Hermitian) dot product.
-fn dot(a: CVec, b: CVec) -> C {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn cross(a: CVec, b: CVec) -> CVec {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-fn norm(a: CVec) -> f64 {
-    a.iter().map(|c| c.norm_sqr()).sum::<f64>().sqrt()
-}
-fn real(a: CVec) -> DVec3 {
-    DVec3::new(a[0].re, a[1].re, a[2].re)
-}
-
-/// A wave's kind: s or p on the isotropic side, ordinary or extraordinary in the crystal.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Mode {
-    /// Isotropic side, electric field across the plane of incidence.
-    S,
-    /// Isotropic side, electric field in the plane of incidence.
-    P,
-    /// Crystal, ordinary wave.
-    O,
-    /// Crystal, extraordinary wave.
-    E,
-    /// Biaxial crystal, the fast wave (the index surface's inner sheet, the smaller index).
-    Fast,
-    /// Biaxial crystal, the slow wave (the outer sheet, the larger index).
-    Slow,
-}
 
 /// A plane wave at the boundary.
 #[derive(Clone, Copy, Debug)]
@@ -84,7 +39,7 @@ pub struct Wave {
 }
 
 impl Wave {
-    fn new(mode: Mode, k: CVec, e: CVec) -> Wave {
+    pub(super) fn new(mode: Mode, k: CVec, e: CVec) -> Wave {
         Wave {
             mode,
             k,
@@ -341,7 +296,7 @@ impl Boundary {
                 self.crystal_wave(x, t, mode, true, s)
             }
             (Incident::Inside { dir, mode }, Optics::Biaxial(x)) => {
-                let k = biaxial::complex(index * dir);
+                let k = cv(index * dir);
                 Wave::new(mode, k, x.field(k, s, mode == Mode::Slow))
             }
         });
@@ -388,119 +343,6 @@ impl Boundary {
             })
         }))
     }
-}
-
-impl Boundary {
-    /// A biaxial crystal's two waves with tangential `t` that leave the boundary into the
-    /// crystal, `[fast, slow]`: of the quartic's four roots, the real ones whose ray goes down
-    /// and the complex ones that decay downward. Two propagating waves are named by their
-    /// indices; beside an evanescent one the propagating wave is the slow one (the line of
-    /// constant `t` misses the inner sheet first); two roots within 1e-6 are one wave along an
-    /// optic axis, given two orthogonal fields. `None` if the roots do not split two and two (a
-    /// wave grazing the boundary).
-    fn biaxial_down(&self, x: &Biaxial, t: DVec3, s: DVec3, roots: [C; 4]) -> Option<[Wave; 2]> {
-        let n = self.normal;
-        let mut down = [(C::from(0.0), false); 2];
-        let mut count = 0;
-        for u in roots {
-            let real = u.im.abs() <= 1e-9 * (1.0 + u.re.abs());
-            let goes_down = if real {
-                x.ray(t + u.re * n).dot(n) < 0.0
-            } else {
-                u.im < 0.0
-            };
-            if goes_down {
-                if count == 2 {
-                    return None;
-                }
-                down[count] = (if real { C::from(u.re) } else { u }, real);
-                count += 1;
-            }
-        }
-        if count != 2 {
-            return None;
-        }
-        let k = |u: C| add(cv(t), scale(cv(n), u));
-        let index = |u: C| norm(k(u));
-        let [(a, ra), (b, rb)] = down;
-        // Fast first.
-        let (fast, slow) = match (ra, rb) {
-            (true, true) if index(a) > index(b) => (b, a),
-            (true, false) => (b, a),
-            _ => (a, b),
-        };
-        let degenerate = ra && rb && (fast - slow).norm_sqr() <= 1e-12 * (1.0 + fast.norm_sqr());
-        let (fast, slow) = if degenerate {
-            let mid = 0.5 * (fast + slow);
-            (mid, mid)
-        } else {
-            (fast, slow)
-        };
-        let (kf, ks) = (k(fast), k(slow));
-        let [ef, es] = if degenerate {
-            x.degenerate_fields(kf, s)
-        } else {
-            [x.field(kf, s, false), x.field(ks, s, false)]
-        };
-        Some([Wave::new(Mode::Fast, kf, ef), Wave::new(Mode::Slow, ks, es)])
-    }
-}
-
-/// A biaxial crystal's quartic roots (the normal components of its four waves) from the last
-/// solve of one boundary event, kept for the next solve of the same event: a camera path's
-/// physical problem has the opposite tangential wave vector of its adjoint one (the reversed
-/// waves), whose roots are the same negated (`F(−t + u m) = F(t − u m)`: Fresnel's equation is
-/// even in `k`). Local to one event, so a render's numbers never depend on what another path
-/// solved.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct Roots(Option<(DVec3, [C; 4])>);
-
-impl Roots {
-    /// The roots for tangential `t` on a boundary with normal `m`: the kept ones for `t` or,
-    /// negated, for `−t` (to 1e-9 of `|t|`: a reversed wave's tangential component, formed from
-    /// its index along its direction, repeats the adjoint's only to the roots' accuracy), else
-    /// solved; kept for the next call.
-    fn of(&mut self, x: &Biaxial, t: DVec3, m: DVec3) -> Option<[C; 4]> {
-        let tol = 1e-18 * (1.0 + t.length_squared());
-        let roots = match self.0 {
-            Some((t0, r)) if (t - t0).length_squared() <= tol => r,
-            Some((t0, r)) if (t + t0).length_squared() <= tol => r.map(|u| -u),
-            _ => x.normal_components(t, m)?,
-        };
-        self.0 = Some((t, roots));
-        Some(roots)
-    }
-}
-
-/// Gaussian elimination with partial pivoting of the 4 × 4 system `a` with `R` right-hand sides
-/// (the columns of `b`); the solutions, one per column.
-fn solve4<const R: usize>(mut a: [[C; 4]; 4], mut b: [[C; R]; 4]) -> Option<[[C; 4]; R]> {
-    for col in 0..4 {
-        let p = (col..4).max_by(|&i, &j| a[i][col].norm().total_cmp(&a[j][col].norm()))?;
-        if !(a[p][col].norm() > 1e-14) {
-            return None;
-        }
-        a.swap(col, p);
-        b.swap(col, p);
-        let (pivot, pb) = (a[col], b[col]);
-        for (row, rb) in a
-            .iter_mut()
-            .zip(b.iter_mut())
-            .enumerate()
-            .filter(|(r, _)| *r != col)
-            .map(|(_, x)| x)
-        {
-            let f = row[col] / pivot[col];
-            for (x, v) in row.iter_mut().zip(pivot).skip(col) {
-                *x -= f * v;
-            }
-            for (x, v) in rb.iter_mut().zip(pb) {
-                *x -= f * v;
-            }
-        }
-    }
-    let x: [[C; 4]; R] = std::array::from_fn(|k| std::array::from_fn(|i| b[i][k] / a[i][i]));
-    x.iter().flatten().all(|c| c.is_finite()).then_some(x)
 }
 
 #[cfg(test)]
@@ -603,10 +445,8 @@ mod tests {
                     Mode::E
                 };
                 // An e wave vector whose energy does not reach the boundary is not incident.
-                if mode == Mode::E {
-                    if b.crystal.ray(d, Mode::E).z <= 1e-6 {
-                        continue;
-                    }
+                if mode == Mode::E && b.crystal.ray(d, Mode::E).z <= 1e-6 {
+                    continue;
                 }
                 Incident::Inside { dir: d, mode }
             } else {

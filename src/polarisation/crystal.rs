@@ -20,7 +20,8 @@
 //! waves' phase indices; in an anisotropic medium the exact invariant also involves the walk-off
 //! angle, which this leaves out (an error of order `ρ²`, below 1 % for calcite's 6°).
 
-use super::boundary::{Boundary, Incident, Mode, Outgoing, Roots};
+use super::biaxial::Roots;
+use super::boundary::{Boundary, Incident, Mode, Outgoing};
 use super::optics::Optics;
 use super::transport::PathPolarisation;
 use glam::DVec3;

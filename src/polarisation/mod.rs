@@ -23,8 +23,10 @@
 //!   polarisation whose `y` component lags.
 
 pub mod biaxial;
+mod biaxial_boundary;
 pub mod boundary;
 pub mod crystal;
+pub mod cvec;
 pub mod fresnel;
 pub mod interference;
 pub mod mueller;

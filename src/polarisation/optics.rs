@@ -2,10 +2,27 @@
 //! ([`super::boundary`]) and the camera path's crystal steps ([`super::crystal`]) ask of it — its
 //! two waves' names, indices, rays, fields and absorption weights.
 
-use super::biaxial::{Biaxial, complex};
-use super::boundary::Mode;
+use super::biaxial::Biaxial;
+use super::cvec::cv as complex;
 use super::uniaxial::Uniaxial;
 use glam::DVec3;
+
+/// A wave's kind: s or p on the isotropic side, ordinary or extraordinary in the crystal.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Mode {
+    /// Isotropic side, electric field across the plane of incidence.
+    S,
+    /// Isotropic side, electric field in the plane of incidence.
+    P,
+    /// Crystal, ordinary wave.
+    O,
+    /// Crystal, extraordinary wave.
+    E,
+    /// Biaxial crystal, the fast wave (the index surface's inner sheet, the smaller index).
+    Fast,
+    /// Biaxial crystal, the slow wave (the outer sheet, the larger index).
+    Slow,
+}
 
 /// A crystal's optics at one wavelength.
 #[derive(Clone, Copy, Debug, PartialEq)]

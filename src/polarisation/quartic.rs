@@ -103,7 +103,7 @@ mod tests {
         ];
         for (k, ri) in r.iter().enumerate() {
             for j in (1..=k + 1).rev() {
-                p[j] = p[j] - *ri * p[j - 1];
+                p[j] -= *ri * p[j - 1];
             }
         }
         [p[4].re, p[3].re, p[2].re, p[1].re]

@@ -159,6 +159,19 @@ impl PathPolarisation {
         k
     }
 
+    /// An element of Mueller matrix `m[c]` per channel (frame axis `x`, unit, across the light's
+    /// propagation `d`) on the segment: the row turned to `x` and multiplied; returns each
+    /// channel's correction `k` (the throughput takes `m₀₀ k`).
+    pub fn element(
+        &mut self,
+        x: Vec3,
+        d: Vec3,
+        m: &[Mueller; MAX_CHANNELS],
+    ) -> [f32; MAX_CHANNELS] {
+        self.rotate_to(x, d);
+        std::array::from_fn(|c| self.apply(c, Some(&m[c])))
+    }
+
     /// Multiplies channel `c`'s row by `m / m₀₀` and renormalises it; returns the correction `k`
     /// (0, and the channel's ratios zeroed, where `m` passes nothing).
     fn apply(&mut self, c: usize, m: Option<&Mueller>) -> f32 {

@@ -327,14 +327,14 @@ impl Compiler<'_> {
             },
         };
         let (platelets, platelet_materials) = self.platelets(desc, body_index, at.unwrap_or(0))?;
-        let crystal = match desc
-            .crystal
-            .as_ref()
-            .map(|c| self.crystal(r, c, desc.ior, at))
-        {
+        let crystal = match desc.crystal.as_ref().map(|c| c.compile(desc.ior)) {
             None => None,
-            Some(Some(c)) => Some(c),
-            Some(None) => return None,
+            Some(Ok(c)) => Some(c),
+            Some(Err((key, m))) => {
+                let pos = r.source.find_from(at.unwrap_or(0), &[key, ":"]).or(at);
+                self.errors.push(r.source.error(pos, m));
+                return None;
+            }
         };
         let body = Body {
             ior: desc.ior,
@@ -371,6 +371,17 @@ impl Compiler<'_> {
                 self.effects.turn_on(
                     Effect::Polarisation,
                     format!("body.crystal ({}:{})", e.file, e.line),
+                );
+            }
+            if body.crystal.is_some_and(|c| c.thin_nm.is_some()) {
+                let d = r
+                    .source
+                    .find_from(at.unwrap_or(0), &["thin_section", ":"])
+                    .or(at);
+                let e = r.source.error(d, "");
+                self.effects.turn_on(
+                    Effect::Spectral,
+                    format!("body.crystal.thin_section ({}:{})", e.file, e.line),
                 );
             }
             if body.dispersion.is_some() {

@@ -9,6 +9,8 @@
 //! crystal: Biaxial(beta: 1.542, gamma: 1.546,            // n_α is the body's `ior`
 //!     x_axis: (1.0, 0.0, 0.0), z_axis: (0.0, 0.0, 1.0),  // the vibration directions of α, γ
 //!     pleochroism: Some((alpha: …, beta: …, gamma: …, distance: 1.0))),
+//! crystal: Uniaxial(ne: 1.553, axis: (1.0, 0.0, 0.0),    // a quartz plate …
+//!     thin_section: Some((unit_nm: 15000.0))),          // … 15 µm per object unit, coherent
 //! ```
 
 use super::color::ColorDesc;
@@ -19,6 +21,7 @@ ranged!(ne_range, "crystal.ne", 1.0001, 4.0);
 ranged!(beta_range, "crystal.beta", 1.0001, 4.0);
 ranged!(gamma_range, "crystal.gamma", 1.0001, 4.0);
 ranged!(pleochroism_distance, "pleochroism.distance", open 0.0, 1e4);
+ranged!(unit_nm_range, "thin_section.unit_nm", open 0.0, 1e7);
 
 /// The optics of a doubly refractive body.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -39,6 +42,9 @@ pub enum CrystalDesc {
         /// Dichroism: absorption that depends on the wave (default none).
         #[serde(default)]
         pleochroism: Option<PleochroismDesc>,
+        /// A thin plate or section whose two waves add coherently (default: a gem, incoherent).
+        #[serde(default)]
+        thin_section: Option<ThinSectionDesc>,
     },
     /// A biaxial crystal (cordierite — iolite —, the feldspars, peridot, topaz): light vibrating
     /// along the principal axis X meets the body's `ior` (n_α), along Y `beta` (n_β), along Z
@@ -61,7 +67,25 @@ pub enum CrystalDesc {
         /// Trichroism: absorption that depends on the vibration direction (default none).
         #[serde(default)]
         pleochroism: Option<TrichroismDesc>,
+        /// A thin plate or section whose two waves add coherently (default: a gem, incoherent).
+        #[serde(default)]
+        thin_section: Option<ThinSectionDesc>,
     },
+}
+
+/// A crystal thin enough — much thinner than white light's coherence length, a few tens of
+/// micrometres — that its two waves leave it together and interfere: a petrographic thin section,
+/// a quartz wedge, a mica plate. Its boundary then refracts as an isotropic one of index `ior`
+/// and its interior acts as a linear retarder of retardation `d (n₂ − n₁)` along each ray (the
+/// Michel-Lévy interference colours between crossed polars; Born & Wolf §15.4.4), the walk-off
+/// neglected. Turns spectral transport on.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ThinSectionDesc {
+    /// Nanometres of crystal per object unit, 0 <..= 1e7 (a 2-unit slab with `unit_nm: 15000`
+    /// is a 30 µm section).
+    #[serde(deserialize_with = "unit_nm_range")]
+    pub unit_nm: f32,
 }
 
 /// Sin² of the smallest angle allowed between a biaxial crystal's `x_axis` and `z_axis` (5°).
@@ -171,42 +195,29 @@ pub fn biaxial_axes(
     Ok([xv, zv.cross(xv), zv])
 }
 
-impl super::map_compiler::Compiler<'_> {
-    /// Compiles a body's `crystal` (the body's keyword at `at`, its index `ior`); errors are
-    /// recorded at the offending keyword.
-    pub(super) fn crystal(
-        &mut self,
-        r: &super::GemRecipe,
-        desc: &CrystalDesc,
-        ior: f32,
-        at: Option<usize>,
-    ) -> Option<crate::scene::body::Crystal> {
+impl CrystalDesc {
+    /// The crystal of a body of index `ior`, or the keyword the error is at and what is wrong.
+    pub fn compile(&self, ior: f32) -> Result<crate::scene::body::Crystal, (&'static str, String)> {
         use crate::scene::body::{Crystal, Indices};
-        let from = at.unwrap_or(0);
-        let fail = |errors: &mut Vec<_>, key: &str, msg: String| {
-            let pos = r.source.find_from(from, &[key, ":"]).or(at);
-            errors.push(r.source.error(pos, msg));
-        };
-        match desc {
+        let pleochroism = |m: String| ("pleochroism", format!("body.crystal.{m}"));
+        match self {
             CrystalDesc::Uniaxial {
                 ne,
                 axis,
-                pleochroism,
+                pleochroism: p,
+                thin_section,
             } => {
-                let (o, e) = match pleochroism.as_ref().map(|p| p.coefficients()) {
+                let (o, e) = match p.as_ref().map(|p| p.coefficients()) {
                     None => (Rgb::ZERO, Rgb::ZERO),
-                    Some(Ok(s)) => s,
-                    Some(Err(m)) => {
-                        fail(&mut self.errors, "pleochroism", format!("body.crystal.{m}"));
-                        return None;
-                    }
+                    Some(r) => r.map_err(pleochroism)?,
                 };
-                Some(Crystal {
+                Ok(Crystal {
                     indices: Indices::Uniaxial {
                         ne: *ne,
                         axis: glam::Vec3::new(axis.0, axis.1, axis.2).normalize(),
                     },
                     sigma: [o, e, Rgb::ZERO],
+                    thin_nm: thin_section.as_ref().map(|t| t.unit_nm),
                 })
             }
             CrystalDesc::Biaxial {
@@ -214,30 +225,22 @@ impl super::map_compiler::Compiler<'_> {
                 gamma,
                 x_axis,
                 z_axis,
-                pleochroism,
+                pleochroism: p,
+                thin_section,
             } => {
-                let axes = match biaxial_axes(ior, *beta, *gamma, *x_axis, *z_axis) {
-                    Ok(a) => a,
-                    Err((key, m)) => {
-                        fail(&mut self.errors, key, m);
-                        return None;
-                    }
-                };
-                let sigma = match pleochroism.as_ref().map(|p| p.coefficients()) {
+                let axes = biaxial_axes(ior, *beta, *gamma, *x_axis, *z_axis)?;
+                let sigma = match p.as_ref().map(|p| p.coefficients()) {
                     None => [Rgb::ZERO; 3],
-                    Some(Ok(s)) => s,
-                    Some(Err(m)) => {
-                        fail(&mut self.errors, "pleochroism", format!("body.crystal.{m}"));
-                        return None;
-                    }
+                    Some(r) => r.map_err(pleochroism)?,
                 };
-                Some(Crystal {
+                Ok(Crystal {
                     indices: Indices::Biaxial {
                         beta: *beta,
                         gamma: *gamma,
                         axes,
                     },
                     sigma,
+                    thin_nm: thin_section.as_ref().map(|t| t.unit_nm),
                 })
             }
         }

@@ -178,11 +178,16 @@ where
                 FreeFlight::Scatter { t, value, pdf } => {
                     path.take_flight(hero, value, pdf);
                     if let Some((c, u)) = pleochroic {
-                        path.beta *=
-                            pleochroic_transmittance::<S>(c, &mut pol, ray.dir, t, u, &path.lambda);
-                        if STOKES && let Some(a) = &mut aov {
-                            a.rows.follow(&pol);
-                        }
+                        let rows = aov.as_mut().filter(|_| STOKES).map(|a| &mut a.rows);
+                        path.beta *= pleochroic_transmittance::<S>(
+                            c,
+                            &mut pol,
+                            rows,
+                            ray.dir,
+                            t,
+                            u,
+                            &path.lambda,
+                        );
                     }
                     if path.medium_events >= world.medium_depth || !path.alive() {
                         break;
@@ -256,11 +261,9 @@ where
         if let Some((c, u)) = pleochroic
             && let Some(h) = &found
         {
+            let rows = aov.as_mut().filter(|_| STOKES).map(|a| &mut a.rows);
             path.beta *=
-                pleochroic_transmittance::<S>(c, &mut pol, ray.dir, h.t(), u, &path.lambda);
-            if STOKES && let Some(a) = &mut aov {
-                a.rows.follow(&pol);
-            }
+                pleochroic_transmittance::<S>(c, &mut pol, rows, ray.dir, h.t(), u, &path.lambda);
         }
         let hit = match found {
             None => {

@@ -6,6 +6,7 @@ use super::shading::SurfaceBsdf;
 use super::world::CrystalOptics;
 use crate::bsdf::{Bsdf, BsdfSample, Lobe, LobeKind, Scatter};
 use crate::color::Rgb;
+use crate::polarisation::Mueller;
 use crate::polarisation::boundary::{Boundary, Mode};
 use crate::polarisation::crystal;
 use crate::polarisation::optics::Optics;
@@ -14,6 +15,7 @@ use crate::polarisation::transport::{InterfaceEvent, MAX_CHANNELS, PathPolarisat
 use crate::polarisation::uniaxial::Uniaxial;
 use crate::spectrum::Spectral;
 use glam::Vec3;
+use num_complex::Complex64 as C;
 
 /// The Stokes AOVs of a camera path ([`crate::polarisation::stokes`]): its four rows and what
 /// each has measured so far, in the path's channels.
@@ -233,14 +235,21 @@ where
 /// segment that has no wave yet (after a depolarising vertex) takes one, each with probability ½
 /// and weight 1 (the unpolarised row is the mean of the two orthogonal waves'), with
 /// `u ∈ [0, 1)`.
+///
+/// A thin section ([`CrystalOptics::thin_nm`]) is [`thin_section`] instead. The Stokes AOVs'
+/// `rows` follow.
 pub(super) fn pleochroic_transmittance<S: Spectral>(
     crystal: &CrystalOptics,
     pol: &mut PathPolarisation,
+    rows: Option<&mut StokesRows>,
     dir: Vec3,
     t: f32,
     u: f32,
     lambda: &S::Wavelengths,
 ) -> S {
+    if let Some(nm) = crystal.thin_nm {
+        return thin_section::<S>(crystal, nm, pol, rows, dir, t, lambda);
+    }
     let optics = crystal.at(f64::from(crystal.no));
     let optics = match (crystal.biaxial, optics) {
         // The uniaxial extraordinary index as the d line's f32 sum (as it always was).
@@ -276,7 +285,80 @@ pub(super) fn pleochroic_transmittance<S: Spectral>(
                 + crystal.sigma[2] * (w[2] as f32)
         }
     };
+    if let Some(r) = rows {
+        r.follow(pol);
+    }
     S::from_unbounded(sigma, lambda).map(|s| (-s * t).exp())
+}
+
+/// Wavelengths (nm) a thin section's retardance is evaluated at in RGB transport, per channel:
+/// about the dominant wavelengths of the sRGB primaries (a thin section turns spectral transport
+/// on; these serve a render forced to RGB).
+const RGB_NM: [f32; MAX_CHANNELS] = [610.0, 550.0, 465.0, 550.0];
+
+/// A thin section's interior over distance `t` along the camera ray's `dir` (unit): its two
+/// waves travel together (walk-off neglected) and leave coherently, so the segment is one linear
+/// retarder and diattenuator — the Jones matrix `diag(a₁, a₂ e^{iδ})` in the frame of the first
+/// wave's field, `δ = 2π t d_nm (n₂ − n₁) / λ` per channel's wavelength and `aⱼ = exp(−σⱼ t / 2)`
+/// each wave's amplitude transmittance (Born & Wolf §15.4.4) — applied to the path's row and
+/// the Stokes AOVs' `rows`. Returns the throughput factor per channel.
+fn thin_section<S: Spectral>(
+    crystal: &CrystalOptics,
+    nm_per_unit: f32,
+    pol: &mut PathPolarisation,
+    rows: Option<&mut StokesRows>,
+    dir: Vec3,
+    t: f32,
+    lambda: &S::Wavelengths,
+) -> S {
+    let optics = crystal.at(f64::from(crystal.no));
+    let ray = dir.as_dvec3();
+    let [m1, m2] = optics.modes();
+    let x1 = optics.field(ray, m1).as_vec3();
+    let retardation =
+        f64::from(t) * f64::from(nm_per_unit) * (optics.index(ray, m2) - optics.index(ray, m1));
+    let sigma = match &optics {
+        // The ordinary wave absorbs σ_ω, the extraordinary σ_ω cos² θ + σ_ε sin² θ (its wave
+        // normal is the ray here).
+        Optics::Uniaxial(x) => {
+            let c2 = ray.dot(x.axis).powi(2) as f32;
+            [
+                crystal.sigma[0],
+                crystal.sigma[0] * c2 + crystal.sigma[1] * (1.0 - c2),
+            ]
+        }
+        Optics::Biaxial(_) => [m1, m2].map(|m| {
+            let w = optics.absorption_weights(ray, m).unwrap_or([1.0 / 3.0; 3]);
+            crystal.sigma[0] * (w[0] as f32)
+                + crystal.sigma[1] * (w[1] as f32)
+                + crystal.sigma[2] * (w[2] as f32)
+        }),
+    };
+    let [s1, s2] = sigma.map(|s| S::from_unbounded(s, lambda));
+    let m: [Mueller; MAX_CHANNELS] = std::array::from_fn(|c| {
+        let (a1, a2) = if c < S::CHANNELS {
+            (s1.channel(c), s2.channel(c))
+        } else {
+            (0.0, 0.0)
+        };
+        let nm = S::wavelength_nm(lambda, c).unwrap_or(RGB_NM[c]);
+        let delta = std::f64::consts::TAU * retardation / f64::from(nm);
+        Mueller::diagonal_jones(
+            C::from(f64::from((-0.5 * a1 * t).exp())),
+            C::from_polar(f64::from((-0.5 * a2 * t).exp()), delta),
+        )
+    });
+    let d = -dir;
+    let k = pol.element(x1, d, &m);
+    if let Some(r) = rows
+        && !r.settled
+    {
+        for j in 0..ROWS {
+            let kj = r.rows[j].element(x1, d, &m);
+            r.rescale(j, kj, k);
+        }
+    }
+    S::from_channels(|c| m[c].0[0][0] as f32 * k[c])
 }
 
 /// The pleochroic crystal a segment in `medium` crosses, with the number that picks its wave
@@ -287,7 +369,10 @@ pub(super) fn pleochroic_segment<'w>(
     medium: crate::geometry::MediumId,
     sampler: &mut crate::sampler::PixelSampler,
 ) -> Option<(&'w CrystalOptics, f32)> {
-    let c = world.crystal.as_ref().filter(|c| c.pleochroic())?;
+    let c = world
+        .crystal
+        .as_ref()
+        .filter(|c| c.pleochroic() || c.thin_nm.is_some())?;
     (medium == world.interior).then(|| (c, sampler.get1d()))
 }
 
@@ -302,7 +387,8 @@ pub(super) fn crystal_boundary<'w, S: Spectral>(
 where
     Bsdf: Scatter<S>,
 {
-    let c = world.crystal.as_ref()?;
+    // A thin section's boundary refracts as an isotropic one (its waves leave together).
+    let c = world.crystal.as_ref().filter(|c| c.thin_nm.is_none())?;
     (matches!(hit, super::world::Hit::Stone(_)) && sb.interface_eta::<S>(0, lambda).is_some())
         .then_some(c)
 }

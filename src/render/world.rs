@@ -160,6 +160,9 @@ pub struct CrystalOptics {
     /// extraordinary wave across the axis; biaxial, of light vibrating along X, Y, Z (zero: not
     /// pleochroic).
     pub sigma: [Rgb; 3],
+    /// A thin section: nanometres of crystal per world unit (its two waves add coherently, its
+    /// boundary refracts as an isotropic one of index `no`); `None`: a gem.
+    pub thin_nm: Option<f32>,
 }
 
 impl CrystalOptics {
@@ -284,6 +287,7 @@ impl World {
                     .max(f32::MIN_POSITIVE);
                 let to_world = |v: Vec3| stage.to_world.transform_vector3(v).normalize();
                 let sigma = c.sigma.map(|s| s * (1.0 / scale));
+                let thin_nm = c.thin_nm.map(|nm| nm / scale);
                 match c.indices {
                     Indices::Uniaxial { ne, axis } => CrystalOptics {
                         no: ior,
@@ -291,6 +295,7 @@ impl World {
                         axis: to_world(axis),
                         biaxial: None,
                         sigma,
+                        thin_nm,
                     },
                     Indices::Biaxial { beta, gamma, axes } => {
                         // Orthonormal again in world space (Gram–Schmidt, X kept).
@@ -303,6 +308,7 @@ impl World {
                             axis: x,
                             biaxial: Some(([beta - ior, gamma - ior], [x, z.cross(x), z])),
                             sigma,
+                            thin_nm,
                         }
                     }
                 }

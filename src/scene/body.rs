@@ -52,6 +52,9 @@ pub struct Crystal {
     /// Absorption per object unit on top of the medium's, per principal wave: uniaxial
     /// `[ω, ε across the axis, 0]`; biaxial `[α, β, γ]` (light vibrating along X, Y, Z).
     pub sigma: [Rgb; 3],
+    /// A thin section ([`crate::recipe::crystal::ThinSectionDesc`]): nanometres of crystal per
+    /// object unit; its two waves add coherently. `None`: a gem, incoherent.
+    pub thin_nm: Option<f32>,
 }
 
 /// A crystal's principal indices and axes; the first index is the body's `ior`.

@@ -196,6 +196,11 @@ impl Spectral for HeroSample {
     const CHANNELS: usize = N;
 
     #[inline]
+    fn wavelength_nm(lambda: &HeroWavelengths, i: usize) -> Option<f32> {
+        lambda.lambda.get(i).copied()
+    }
+
+    #[inline]
     fn from_channels(f: impl Fn(usize) -> f32) -> Self {
         HeroSample(std::array::from_fn(f))
     }

@@ -84,6 +84,10 @@ pub trait Spectral:
     /// The wavelengths of a camera path from the sampler's wavelength slot `u ∈ [0, 1)`
     /// ([`crate::sampler`] layout).
     fn sample_wavelengths(u: f32) -> Self::Wavelengths;
+    /// Channel `i`'s wavelength in nm, for a variant that carries wavelengths (`None` for RGB).
+    fn wavelength_nm(_lambda: &Self::Wavelengths, _i: usize) -> Option<f32> {
+        None
+    }
     /// A stored reflectance (0 … 1 per channel) at the wavelengths.
     fn from_reflectance(c: Rgb, lambda: &Self::Wavelengths) -> Self;
     /// A stored unbounded quantity (radiance, absorption coefficient, complex IOR part) at the
