@@ -98,8 +98,16 @@ impl Optics {
                     (_, Some(a)) => a.cross(ray).normalize(),
                 }
             }
+            Optics::Biaxial(_) => self.field_of_normal(self.wave_of_ray(ray, mode), ray, mode),
+        }
+    }
+
+    /// [`Optics::field`] of the wave `mode` with unit wave normal `s` and ray `ray` (a biaxial
+    /// crystal's; a uniaxial crystal's field needs only the ray).
+    pub fn field_of_normal(&self, s: DVec3, ray: DVec3, mode: Mode) -> DVec3 {
+        match self {
+            Optics::Uniaxial(_) => self.field(ray, mode),
             Optics::Biaxial(x) => {
-                let s = self.wave_of_ray(ray, mode);
                 let k = self.index(s, mode) * s;
                 let reference = ray.any_orthonormal_vector();
                 let e = x.field(complex(k), reference, mode == Mode::Slow);
@@ -115,10 +123,15 @@ impl Optics {
     /// uniaxial crystal gives `σ_ω cos² θ + σ_ε sin² θ`. `None` for a uniaxial crystal (its
     /// renderer keeps that closed form).
     pub fn absorption_weights(&self, ray: DVec3, mode: Mode) -> Option<[f64; 3]> {
+        self.absorption_weights_of(self.wave_of_ray(ray, mode), ray, mode)
+    }
+
+    /// [`Optics::absorption_weights`] of the wave with unit wave normal `s`.
+    pub fn absorption_weights_of(&self, s: DVec3, ray: DVec3, mode: Mode) -> Option<[f64; 3]> {
         let Optics::Biaxial(x) = self else {
             return None;
         };
-        let d = x.displacement(self.field(ray, mode));
+        let d = x.displacement(self.field_of_normal(s, ray, mode));
         Some(x.axes.map(|a| a.dot(d).powi(2)))
     }
 }

@@ -57,6 +57,7 @@ impl StokesRows {
             x,
             w: [w; MAX_CHANNELS],
             mode: None,
+            normal: glam::DVec3::ZERO,
         };
         StokesRows {
             rows: [

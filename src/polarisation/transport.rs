@@ -43,6 +43,10 @@ pub struct PathPolarisation {
     /// then that wave's pure polarisation, [`super::crystal`]); `None` elsewhere, and inside
     /// after a depolarising vertex.
     pub mode: Option<super::boundary::Mode>,
+    /// With `mode`, that wave's unit wave normal, oriented along the camera path, where the
+    /// boundary that made it knew it (zero otherwise): a biaxial crystal's ray does not always
+    /// name one wave (near an optic axis two normals of a sheet share a ray).
+    pub normal: glam::DVec3,
 }
 
 /// An interface event's kind.
@@ -60,6 +64,7 @@ impl PathPolarisation {
         x: Vec3::X,
         w: [[0.0; 3]; MAX_CHANNELS],
         mode: None,
+        normal: glam::DVec3::ZERO,
     };
 
     /// The row of a camera behind an ideal linear analyser whose transmission axis is `axis`
@@ -74,6 +79,7 @@ impl PathPolarisation {
                 x,
                 w: [[1.0, 0.0, 0.0]; MAX_CHANNELS],
                 mode: None,
+                normal: glam::DVec3::ZERO,
             },
             None => PathPolarisation::UNPOLARISED,
         }
@@ -90,6 +96,7 @@ impl PathPolarisation {
     pub fn depolarise(&mut self) {
         self.w = [[0.0; 3]; MAX_CHANNELS];
         self.mode = None;
+        self.normal = glam::DVec3::ZERO;
     }
 
     /// Re-expresses the row in the frame with axis `x_new` (unit, orthogonal to the light's
@@ -299,6 +306,7 @@ mod tests {
             x: x0,
             w: [[0.6, -0.3, 0.5]; MAX_CHANNELS],
             mode: None,
+            normal: glam::DVec3::ZERO,
         };
         let s = Stokes([1.0, 0.2, -0.7, 0.4]);
         let before = measure(&p, s);

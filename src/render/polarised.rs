@@ -277,8 +277,14 @@ pub(super) fn pleochroic_transmittance<S: Spectral>(
             crystal.sigma[0] * c2 + crystal.sigma[1] * (1.0 - c2)
         }
         (_, Optics::Biaxial(_)) => {
+            // The wave normal its boundary made, where the path knows it.
+            let s = if pol.normal.dot(ray) > 0.0 {
+                pol.normal
+            } else {
+                optics.wave_of_ray(ray, mode)
+            };
             let w = optics
-                .absorption_weights(ray, mode)
+                .absorption_weights_of(s, ray, mode)
                 .unwrap_or([1.0 / 3.0; 3]);
             crystal.sigma[0] * (w[0] as f32)
                 + crystal.sigma[1] * (w[1] as f32)
