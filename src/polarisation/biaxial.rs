@@ -266,12 +266,13 @@ impl Roots {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::polarisation::uniaxial::Uniaxial;
     use crate::sampler::Rng;
 
-    fn random_unit(rng: &mut Rng) -> DVec3 {
+    /// A random unit vector.
+    pub(in crate::polarisation) fn random_unit(rng: &mut Rng) -> DVec3 {
         let z = 2.0 * f64::from(rng.uniform()) - 1.0;
         let phi = std::f64::consts::TAU * f64::from(rng.uniform());
         let r = (1.0 - z * z).sqrt();
@@ -279,7 +280,7 @@ mod tests {
     }
 
     /// A random orthonormal frame.
-    fn random_axes(rng: &mut Rng) -> [DVec3; 3] {
+    pub(in crate::polarisation) fn random_axes(rng: &mut Rng) -> [DVec3; 3] {
         let x = random_unit(rng);
         let y = x.cross(random_unit(rng)).normalize();
         [x, y, x.cross(y)]
@@ -288,8 +289,9 @@ mod tests {
     /// Cordierite (iolite) at the d line, mid-range of its published indices (Deer, Howie &
     /// Zussman, *Rock-Forming Minerals* vol. 1B, 1986: n_α 1.522–1.560, n_β 1.524–1.574,
     /// n_γ 1.527–1.578); a strongly birefringent made-up crystal beside it for larger walk-offs.
-    const IOLITE: [f64; 3] = [1.537, 1.542, 1.546];
-    const STRONG: [f64; 3] = [1.5, 1.65, 1.72];
+    pub(in crate::polarisation) const IOLITE: [f64; 3] = [1.537, 1.542, 1.546];
+    /// A strongly biaxial made-up crystal.
+    pub(in crate::polarisation) const STRONG: [f64; 3] = [1.5, 1.65, 1.72];
 
     /// With two equal indices the crystal is uniaxial: the indices and rays equal
     /// [`Uniaxial`]'s ordinary and extraordinary ones (positive: axis Z; negative: axis X).

@@ -78,23 +78,7 @@ mod tests {
     use crate::polarisation::uniaxial::Uniaxial;
     use crate::sampler::Rng;
 
-    fn random_unit(rng: &mut Rng) -> DVec3 {
-        let z = 2.0 * f64::from(rng.uniform()) - 1.0;
-        let phi = std::f64::consts::TAU * f64::from(rng.uniform());
-        let r = (1.0 - z * z).sqrt();
-        DVec3::new(r * phi.cos(), r * phi.sin(), z)
-    }
-
-    /// A random orthonormal frame.
-    fn random_axes(rng: &mut Rng) -> [DVec3; 3] {
-        let x = random_unit(rng);
-        let y = x.cross(random_unit(rng)).normalize();
-        [x, y, x.cross(y)]
-    }
-
-    /// Iolite and a strongly biaxial made-up crystal ([`super::super::biaxial`]'s tests).
-    const IOLITE: [f64; 3] = [1.537, 1.542, 1.546];
-    const STRONG: [f64; 3] = [1.5, 1.65, 1.72];
+    use crate::polarisation::biaxial::tests::{IOLITE, STRONG, random_axes, random_unit};
 
     fn boundary(n: [f64; 3], axes: [DVec3; 3]) -> Boundary {
         Boundary {

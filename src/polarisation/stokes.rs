@@ -57,7 +57,7 @@ impl StokesRows {
             x,
             w: [w; MAX_CHANNELS],
             mode: None,
-            normal: glam::DVec3::ZERO,
+            normal: Vec3::ZERO,
         };
         StokesRows {
             rows: [

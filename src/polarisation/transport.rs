@@ -46,7 +46,7 @@ pub struct PathPolarisation {
     /// With `mode`, that wave's unit wave normal, oriented along the camera path, where the
     /// boundary that made it knew it (zero otherwise): a biaxial crystal's ray does not always
     /// name one wave (near an optic axis two normals of a sheet share a ray).
-    pub normal: glam::DVec3,
+    pub normal: Vec3,
 }
 
 /// An interface event's kind.
@@ -64,7 +64,7 @@ impl PathPolarisation {
         x: Vec3::X,
         w: [[0.0; 3]; MAX_CHANNELS],
         mode: None,
-        normal: glam::DVec3::ZERO,
+        normal: Vec3::ZERO,
     };
 
     /// The row of a camera behind an ideal linear analyser whose transmission axis is `axis`
@@ -79,7 +79,7 @@ impl PathPolarisation {
                 x,
                 w: [[1.0, 0.0, 0.0]; MAX_CHANNELS],
                 mode: None,
-                normal: glam::DVec3::ZERO,
+                normal: Vec3::ZERO,
             },
             None => PathPolarisation::UNPOLARISED,
         }
@@ -96,7 +96,7 @@ impl PathPolarisation {
     pub fn depolarise(&mut self) {
         self.w = [[0.0; 3]; MAX_CHANNELS];
         self.mode = None;
-        self.normal = glam::DVec3::ZERO;
+        self.normal = Vec3::ZERO;
     }
 
     /// Re-expresses the row in the frame with axis `x_new` (unit, orthogonal to the light's
@@ -306,7 +306,7 @@ mod tests {
             x: x0,
             w: [[0.6, -0.3, 0.5]; MAX_CHANNELS],
             mode: None,
-            normal: glam::DVec3::ZERO,
+            normal: Vec3::ZERO,
         };
         let s = Stokes([1.0, 0.2, -0.7, 0.4]);
         let before = measure(&p, s);

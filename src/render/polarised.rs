@@ -278,8 +278,8 @@ pub(super) fn pleochroic_transmittance<S: Spectral>(
         }
         (_, Optics::Biaxial(_)) => {
             // The wave normal its boundary made, where the path knows it.
-            let s = if pol.normal.dot(ray) > 0.0 {
-                pol.normal
+            let s = if pol.normal.as_dvec3().dot(ray) > 0.0 {
+                pol.normal.as_dvec3().normalize()
             } else {
                 optics.wave_of_ray(ray, mode)
             };
