@@ -207,17 +207,12 @@ impl Boundary {
     ) -> Option<[Outgoing; 4]> {
         let (t, s, index) = self.tangential(incident, reference);
         let out = self.outgoing(t, s, roots)?;
-        self.amplitudes(incident, index, t, s, &out)
+        self.amplitudes([incident], index, t, s, &out).map(|[o]| o)
     }
 
     /// [`Boundary::solve`] for an s and a p wave from outside along the unit `dir` (toward the
-    /// crystal), `[s, p]`: the outgoing waves, which depend only on the tangential wave vector,
-    /// found once.
-    pub fn solve_sp(&self, dir: DVec3, reference: DVec3) -> Option<[[Outgoing; 4]; 2]> {
-        self.solve_sp_in(dir, reference, &mut Roots::default())
-    }
-
-    /// [`Boundary::solve_sp`] reusing and updating `roots` as [`Boundary::solve_in`].
+    /// crystal), `[s, p]` — the outgoing waves, which depend only on the tangential wave vector,
+    /// found once — reusing and updating `roots` as [`Boundary::solve_in`].
     pub fn solve_sp_in(
         &self,
         dir: DVec3,
@@ -227,7 +222,7 @@ impl Boundary {
         let inc = |mode| Incident::Outside { dir, mode };
         let (t, s, index) = self.tangential(inc(Mode::S), reference);
         let out = self.outgoing(t, s, roots)?;
-        self.amplitudes_of([inc(Mode::S), inc(Mode::P)], index, t, s, &out)
+        self.amplitudes([inc(Mode::S), inc(Mode::P)], index, t, s, &out)
     }
 
     /// The tangential wave vector of `incident`, the s axis and the incident wave's index.
@@ -265,23 +260,11 @@ impl Boundary {
         ])
     }
 
-    /// The amplitudes and powers of the `out` waves for `incident` (of index `index`).
-    fn amplitudes(
-        &self,
-        incident: Incident,
-        index: f64,
-        t: DVec3,
-        s: DVec3,
-        out: &[Wave; 4],
-    ) -> Option<[Outgoing; 4]> {
-        self.amplitudes_of([incident], index, t, s, out)
-            .map(|[o]| o)
-    }
-
-    /// [`Boundary::amplitudes`] of `R` incident waves with the same tangential wave vector: one
+    /// The amplitudes and powers of the `out` waves for `R` incident waves (of index `index`) with
+    /// the same tangential wave vector: one
     /// elimination of the boundary's matrix with `R` right-hand sides (each column's numbers are
     /// those of its own elimination); `None` if any of them fails.
-    fn amplitudes_of<const R: usize>(
+    fn amplitudes<const R: usize>(
         &self,
         incidents: [Incident; R],
         index: f64,
