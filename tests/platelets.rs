@@ -82,6 +82,8 @@ mod caustics;
 mod demand;
 #[path = "platelets/energy.rs"]
 mod energy;
+#[path = "platelets/exact.rs"]
+mod exact;
 #[path = "platelets/flights.rs"]
 mod flights;
 #[path = "platelets/hard.rs"]

@@ -146,6 +146,11 @@ impl Cabochon {
         (self.inv_upper, self.inv_lower)
     }
 
+    /// `h / base`: the upper frame's `y` to the lower frame's (0 for a flat base).
+    pub(crate) fn lower_y(&self) -> f32 {
+        self.lower_y
+    }
+
     /// A vector of the upper dome's normalised frame in the lower dome's.
     #[inline(always)]
     fn lower_frame(&self, v: Vec3) -> Vec3 {

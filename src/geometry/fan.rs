@@ -16,7 +16,7 @@ use super::hit::valid_direction;
 use super::placed::PlacedCabochon;
 use super::ray::Ray;
 use super::stone::{Stone, StoneHit};
-use glam::Vec3;
+use glam::{Mat3A, Vec3};
 
 /// How a [`Fan`] meets the stone.
 #[derive(Clone, Copy, Debug)]
@@ -90,6 +90,48 @@ impl<'a> Fan<'a> {
                 self.finish(h.t, h.p, ng, ns, h.facet)
             }
         }
+    }
+
+    /// Whether [`Fan::intersect_curved`] knows the surface's curvature (a placed cabochon;
+    /// the other solids may be meshes with interpolated normals or have edges between facets).
+    #[inline]
+    pub fn has_shape_operator(&self) -> bool {
+        matches!(self.kind, Kind::Cabochon(..))
+    }
+
+    /// [`Fan::intersect`] (the same hit, bit for bit) with the surface's curvature there
+    /// ([`Curvature`]); `None` for the curvature where [`Fan::has_shape_operator`] is false.
+    #[inline]
+    pub fn intersect_curved(&self, dir: Vec3, t_max: f32) -> Option<(StoneHit, Option<Curvature>)> {
+        let Kind::Cabochon(c, org) = self.kind else {
+            return self.intersect(dir, t_max).map(|h| (h, None));
+        };
+        if !valid_direction(dir, t_max) {
+            return None;
+        }
+        let d = c.to_frame.transform_vector3(dir);
+        let (t, piece) = c.shape.first_hit(&org, d, t_max)?;
+        let dome = |g: Vec3, field: Mat3A| {
+            let inv_len = g.length().recip();
+            (g.normalize_or_zero(), Curvature { field, inv_len })
+        };
+        let (ng, curvature) = match piece {
+            Piece::Base(_) => (
+                c.base_normal,
+                Curvature {
+                    field: Mat3A::ZERO,
+                    inv_len: 0.0,
+                },
+            ),
+            Piece::Upper(u) => dome(c.upper_normal * u, c.upper_shape),
+            Piece::Lower(u) => dome(c.lower_normal * u, c.lower_shape),
+        };
+        let p_object = c.shape.point(piece);
+        let h = self.finish(t, p_object, ng, ng, None)?;
+        curvature
+            .inv_len
+            .is_finite()
+            .then_some((h, Some(curvature)))
     }
 
     /// The world hit from the object-space point and the world normals; `None` where they
@@ -179,5 +221,26 @@ impl Stone {
     /// Whether the stone blocks the world ray anywhere in `0 < t < t_max`.
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
         self.fan(ray.origin).occluded(ray.dir, t_max)
+    }
+}
+
+/// How the unit normal turns along the surface at a hit (its shape operator `S`, world
+/// units⁻¹): `δn = S δx` for a displacement `δx` of the point along the surface. A dome's normal
+/// is `n = g/|g|` with `g = F x + const` (`F` the dome's `*_shape` matrix: the normal matrix
+/// times the world-to-frame map), so `S δx = (I − n nᵀ) F δx / |g|`; the flat base's is zero.
+#[derive(Clone, Copy, Debug)]
+pub struct Curvature {
+    /// `F`, world units⁻¹ (zero on the flat base).
+    field: Mat3A,
+    /// `1 / |g|`.
+    inv_len: f32,
+}
+
+impl Curvature {
+    /// `δn = S δx` at the hit whose unit normal is `n`.
+    #[inline]
+    pub fn turn(&self, n: Vec3, dx: Vec3) -> Vec3 {
+        let w = self.field * dx;
+        (w - n * n.dot(w)) * self.inv_len
     }
 }

@@ -25,6 +25,14 @@ pub(crate) struct PlacedCabochon {
     pub(crate) lower_normal: Mat3A,
     /// The flat base's unit world normal.
     pub(crate) base_normal: Vec3,
+    /// The upper dome's normal field differentiated along the world: `upper_normal · L`, with
+    /// `L` the linear part of `to_frame`. At a hit whose unnormalised normal is `g`, the unit
+    /// normal changes by `(I − n nᵀ) · upper_shape · δx / |g|` for a displacement `δx` along the
+    /// surface (the shape operator; [`super::Fan::intersect_curved`]).
+    pub(crate) upper_shape: Mat3A,
+    /// The same for the lower dome: `lower_normal · diag(1, h/base, 1) · L` (zero for a flat
+    /// base).
+    pub(crate) lower_shape: Mat3A,
 }
 
 impl PlacedCabochon {
@@ -39,12 +47,17 @@ impl PlacedCabochon {
         } else {
             normal_to_world * scale(inv_lower)
         };
+        let upper_normal = normal_to_world * scale(inv_upper);
+        let lower_shape =
+            lower_normal * scale(Vec3::new(1.0, shape.lower_y(), 1.0)) * to_frame.matrix3;
         PlacedCabochon {
             shape,
             to_frame,
-            upper_normal: normal_to_world * scale(inv_upper),
+            upper_normal,
             lower_normal,
             base_normal: (normal_to_world * Vec3::NEG_Y).normalize_or_zero(),
+            upper_shape: upper_normal * to_frame.matrix3,
+            lower_shape,
         }
     }
 }

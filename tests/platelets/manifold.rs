@@ -27,8 +27,13 @@ const MIN_LIT: usize = 100;
 /// A stage with one disc light of radius `r` at height 4 facing down, a black sky, no floor and
 /// an orthographic camera looking at the unit sphere.
 fn lit_stage(r: f32, size: u32, spp: u32) -> String {
+    lit_shape("Sphere(radius: 1.0)", r, size, spp)
+}
+
+/// [`lit_stage`] with another stone `shape`.
+pub(super) fn lit_shape(shape: &str, r: f32, size: u32, spp: u32) -> String {
     format!(
-        "(shape: Sphere(radius: 1.0), ground: Off, environment: Constant(Gray(0.0)),
+        "(shape: {shape}, ground: Off, environment: Constant(Gray(0.0)),
           lights: [Disc(center: (0.0, 4.0, 0.0), target: (0.0, 0.0, 0.0), radius: {r},
                         radiance: Gray(20.0))],
           camera: Orthographic(from: (0.3, 1.0, 5.0), to: (0.0, 0.0, 0.0), height: 2.2),
@@ -37,15 +42,20 @@ fn lit_stage(r: f32, size: u32, spp: u32) -> String {
 }
 
 /// A clear sphere of IOR `ior` holding sparse white Lambertian platelets.
-fn world(ior: f32) -> (Scene, World) {
+pub(super) fn world(ior: f32) -> (Scene, World) {
+    shaped_world("Sphere(radius: 1.0)", ior)
+}
+
+/// [`world`] with another stone `shape`.
+pub(super) fn shaped_world(shape: &str, ior: f32) -> (Scene, World) {
     let body = format!(
         "(ior: {ior}, platelets: [(density: 20.0, radius: (0.1, 0.2), orientation: Uniform,
                                   entries: [(1.0, \"mica\")], seed: 5)])"
     );
-    build(&gem(&body, &lit_stage(0.5, 8, 1)))
+    build(&gem(&body, &lit_shape(shape, 0.5, 8, 1)))
 }
 
-fn light(world: &World) -> (Vec3, Vec3, f32) {
+pub(super) fn light(world: &World) -> (Vec3, Vec3, f32) {
     let a = &world.areas[0];
     (Vec3::new(0.0, 4.0, 0.0), a.normal(), a.area())
 }
@@ -96,9 +106,6 @@ fn refracted_hit(w: &World, x0: Vec3, d: Vec3, eta: f32) -> Option<Vec3> {
 /// which 663 of 9 216 (at |x0| = 0.7) and 9 054 of 9 216 (at 0.97) walks failed.
 #[test]
 fn walk_measure_integrates_to_the_refracted_solid_angle() {
-    let eta = 1.5;
-    let (_, w) = world(eta);
-    let (c, n, area) = light(&w);
     let vertices = [
         Vec3::new(0.0, 0.0, 0.0),
         Vec3::new(0.3, -0.2, 0.1),
@@ -106,6 +113,14 @@ fn walk_measure_integrates_to_the_refracted_solid_angle() {
         Vec3::new(0.55, 0.75, 0.3),
         Vec3::new(0.2, 0.97, 0.0),
     ];
+    measure_integrates("Sphere(radius: 1.0)", &vertices);
+}
+
+/// (b) for the stone `shape` (the unit sphere's light) from each of `vertices`.
+pub(super) fn measure_integrates(shape: &str, vertices: &[Vec3]) {
+    let eta = 1.5;
+    let (_, w) = shaped_world(shape, eta);
+    let (c, n, area) = light(&w);
     let limit = z_limit(ALPHA, vertices.len());
     for (k, &x0) in vertices.iter().enumerate() {
         // The walk: stratified points on the disc (polar, area-uniform).

@@ -25,10 +25,14 @@
 //! reflected on its way to the solution (with the refracted form, walks from vertices near the
 //! boundary stalled at the critical angle and the images of tests/platelets/manifold.rs came out
 //! 5–6 % darker than BSDF sampling's; with this one they agree within noise). Newton's method on the two tangent coordinates of `d`,
-//! seeded with the straight line `x0 → x2`, with the Jacobian by forward differences (the
-//! boundary may be any solid or mesh, so its curvature is not available in closed form), a step
-//! bounded by [`MAX_STEP`] and halved while the residual grows, at most [`MAX_ITERATIONS`]
-//! iterations; if that fails, a continuation in the index from `η = 1` ([`solve`]). A solution
+//! seeded with the straight line `x0 → x2`, a step bounded by [`MAX_STEP`] and halved while the
+//! residual grows, at most [`MAX_ITERATIONS`] iterations; if that fails, a continuation in the
+//! index from `η = 1` ([`solve`]). Out of a cabochon the Jacobian is exact at every iterate: the
+//! exit point's motion, the light direction's and the normal's through the domes' shape
+//! operator (`geometry::Curvature`), one trace per iteration and none for the measure. The
+//! other boundaries may be meshes or faceted solids whose curvature is not available in closed
+//! form, and a [`Chain::Through`] also moves its entry refraction: there the Jacobian is taken
+//! by forward differences once and carried by Broyden's updates. A solution
 //! must refract onto the light (the refracted ray heads for `x2`). Light points no refracted ray
 //! from `x0` reaches (near the boundary, many are: total internal reflection closes part of the
 //! sky) have no solution and contribute nothing, as they should; a reachable point the walk misses
@@ -38,8 +42,8 @@
 //! at `x0` per unit area on the light along the refracted path (Hanika et al.'s generalised
 //! geometry term). By the implicit function theorem on `C(d, x2) = 0`,
 //! `|dω0/dA2| = |det ∂C/∂x2| / |det ∂C/∂d|`: `∂C/∂x2 = −P (I − u uᵀ)/L` on the light's plane
-//! (`P` the tangential projection at `x1`, `L = |x2 − x1|`) in closed form, and `∂C/∂d` by
-//! central differences at the solution (tangent coordinates of `d` measure solid angle there).
+//! (`P` the tangential projection at `x1`, `L = |x2 − x1|`) in closed form, and `∂C/∂d` exact
+//! (a cabochon) or by central differences at the solution (tangent coordinates of `d` measure solid angle there).
 //! Without an interface (`η = 1`) this is exactly `cos θ_light / |x2 − x0|²` (tested), and through
 //! a glass sphere its integral over a light equals the solid angle of the refracted rays that
 //! reach it (tested by shooting).
@@ -56,19 +60,21 @@
 //! keeps it whole. The seed is the straight line, so a light point whose straight line misses
 //! the body gets no walk from the floor (BSDF sampling alone finds those paths).
 //!
-//! Files: [`walk`] solves for the connection and its measure; [`light`] turns a connection into a
-//! light sample and gives the density the MIS weight needs.
+//! Files: [`walk`] solves for the connection and its measure (`exact.rs` the walk with the
+//! exact Jacobian, `newton.rs` what both walks share); [`light`] turns a connection into a light
+//! sample and gives the density the MIS weight needs.
 
+mod exact;
 pub mod light;
+mod newton;
 pub mod walk;
 
 pub use light::{
     ManifoldLight, WALK_THRESHOLD, WalkNumbers, WalkVertex, density, sample_light, transmittance,
     walk_probability,
 };
-pub use walk::{
-    Chain, Connection, Entry, Exit, MAX_ITERATIONS, MAX_STEP, STAGES, TOLERANCE, exit, solve,
-};
+pub use newton::{MAX_ITERATIONS, MAX_STEP, TOLERANCE};
+pub use walk::{Chain, Connection, Entry, Exit, STAGES, exit, solve};
 
 use crate::light::Area;
 

@@ -1,22 +1,15 @@
 //! The manifold walk: Newton's method on the direction at the vertex, and the measure of the
 //! connection it finds (module docs in [`super`]).
 
+use super::exact::{self, Linearised};
+use super::newton::{MAX_HALVINGS, MAX_ITERATIONS, TOLERANCE, det, step, turn};
 use crate::bsdf::refract;
 use crate::geometry::{Fan, Frame, StoneHit, offset_origin};
 use crate::render::world::World;
 use glam::{Vec2, Vec3};
 
-/// Most Newton iterations of one walk.
-pub const MAX_ITERATIONS: u32 = 24;
-/// Largest change of direction per Newton step, radians.
-pub const MAX_STEP: f32 = 0.2;
-/// The walk has converged when the refracted direction is within this angle (radians) of the
-/// direction to the light point.
-pub const TOLERANCE: f32 = 1e-5;
 /// Finite-difference step of the constraint's Jacobian, radians.
 const FD_STEP: f32 = 1e-3;
-/// Most halvings of one Newton step while the residual grows.
-const MAX_HALVINGS: u32 = 6;
 
 /// The chain of specular events between the vertex and the light that the walk solves for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -144,6 +137,11 @@ pub fn exit(world: &World, x0: Vec3, d: Vec3, eta: f32, chain: Chain) -> Option<
 /// [`exit`] along direction `d` of the rays `from` the vertex.
 fn exit_from(world: &World, from: &Fan, d: Vec3, eta: f32, chain: Chain) -> Option<Exit> {
     let (h, inside, entry) = last(world, from, d, eta, chain)?;
+    exit_of(h, inside, eta, entry)
+}
+
+/// The exit through boundary hit `h` of the direction `inside` arriving there from inside.
+fn exit_of(h: StoneHit, inside: Vec3, eta: f32, entry: Option<Entry>) -> Option<Exit> {
     // `refract` takes the direction away from the surface on the incident side.
     let out = refract(-inside, h.ns, eta)?;
     Some(Exit {
@@ -242,16 +240,8 @@ impl Problem<'_> {
             if c.length() < tolerance {
                 return Some(d);
             }
-            let dt = det(&j);
             let r = coords(c);
-            let mut step = if dt.abs() > 1e-12 && dt.is_finite() {
-                -Vec2::new(j[1][1] * r.x - j[0][1] * r.y, j[0][0] * r.y - j[1][0] * r.x) / dt
-            } else {
-                Vec2::ZERO
-            };
-            if step.length() > MAX_STEP {
-                step *= MAX_STEP / step.length();
-            }
+            let mut step = step(&j, r).unwrap_or(Vec2::ZERO);
             let mut accepted = None;
             if step.length() > 0.0 {
                 for _ in 0..=MAX_HALVINGS {
@@ -294,15 +284,34 @@ impl Problem<'_> {
 
     /// `|dω0/dA2|` (world units⁻²) at the solution `d` whose exit point is `x1` with shading
     /// normal `n1` (module docs): `|det ∂C/∂x2| / |det ∂C/∂d|` in the tangent basis at `x1`,
-    /// `∂C/∂x2` in closed form on the light's plane (unit normal `n_light`) and `∂C/∂d` by central
-    /// differences. `None` if a perturbed ray does not leave the stone or the map is singular.
-    fn measure(&self, d: Vec3, n_light: Vec3, x1: Vec3, n1: Vec3) -> Option<f32> {
+    /// `∂C/∂x2` in closed form on the light's plane (unit normal `n_light`) and `∂C/∂d` from
+    /// `exact` (the exact walk's linearisation at `d`) or else by central differences. `None` if a perturbed
+    /// ray does not leave the stone or the map is singular.
+    fn measure(
+        &self,
+        d: Vec3,
+        n_light: Vec3,
+        x1: Vec3,
+        n1: Vec3,
+        exact: Option<&Linearised>,
+    ) -> Option<f32> {
         let to_light = self.x2 - x1;
         let l = to_light.length();
         let u = to_light / l;
         let b = Frame::from_normal(n1);
         let basis = (b.s, b.t);
-        let jd = self.jacobian_at(&Frame::from_normal(d), Vec2::ZERO, basis, None)?;
+        let jd = match exact {
+            // Unit tangents of `d` measure solid angle at `d` as the differences' angles do.
+            Some(lin) => {
+                let f = Frame::from_normal(d);
+                let (cs, ct) = (lin.derivative(f.s), lin.derivative(f.t));
+                [
+                    [cs.dot(basis.0), ct.dot(basis.0)],
+                    [cs.dot(basis.1), ct.dot(basis.1)],
+                ]
+            }
+            None => self.jacobian_at(&Frame::from_normal(d), Vec2::ZERO, basis, None)?,
+        };
         // ∂C/∂x2 = −P_tangent (I − u uᵀ) / L on the light's plane (axes a, b).
         let light = Frame::from_normal(n_light);
         let col = |e: Vec3| -(e - u * u.dot(e)) / l;
@@ -314,17 +323,6 @@ impl Problem<'_> {
         let jac = det(&jx).abs() / det(&jd).abs();
         (jac.is_finite() && jac > 0.0).then_some(jac)
     }
-}
-
-/// `d` turned by the tangent coordinates `a` (radians, small) in `frame` (whose normal is `d`).
-#[inline]
-fn turn(frame: &Frame, a: Vec2) -> Vec3 {
-    (frame.n + frame.s * a.x + frame.t * a.y).normalize()
-}
-
-#[inline]
-fn det(j: &[[f32; 2]; 2]) -> f32 {
-    j[0][0] * j[1][1] - j[0][1] * j[1][0]
 }
 
 /// Stages of the continuation in the index.
@@ -357,34 +355,62 @@ pub fn solve(
         eta,
         chain,
     };
-    let d = match problem.newton(seed, TOLERANCE) {
-        Some(d) => d,
-        None => {
-            let mut d = seed;
-            for k in 1..=STAGES {
-                let eta_k = 1.0 + (eta - 1.0) * k as f32 / STAGES as f32;
-                let tol = if k == STAGES {
-                    TOLERANCE
-                } else {
-                    STAGE_TOLERANCE
-                };
-                d = Problem {
-                    eta: eta_k,
-                    ..problem
-                }
-                .newton(d, tol)?;
-            }
-            d
-        }
-    };
+    // Out of a cabochon the walk takes the exact Jacobian (no finite differences); through
+    // any other stone, or through the body and out again, Broyden's updates.
+    if chain == Chain::Out && problem.from.has_shape_operator() {
+        let walk = |p: &Problem, seed, tol| exact::newton(&p.from, p.x2, p.eta, seed, tol);
+        let (d, lin) = continued(&problem, seed, walk)?;
+        let e = exit_of(lin.hit, d, eta, None)?;
+        return connect(&problem, d, e, n_light, Some(&lin));
+    }
+    let walk = |p: &Problem, seed, tol| p.newton(seed, tol).map(|d| (d, ()));
+    let (d, ()) = continued(&problem, seed, walk)?;
     let e = exit_from(world, &problem.from, d, eta, chain)?;
-    let to_light = x2 - e.p;
+    connect(&problem, d, e, n_light, None)
+}
+
+/// Newton's method by `walk` from `seed`, else the continuation in the index from `η = 1`
+/// through [`STAGES`] stages ([`solve`]).
+fn continued<T>(
+    problem: &Problem,
+    seed: Vec3,
+    walk: impl Fn(&Problem, Vec3, f32) -> Option<(Vec3, T)>,
+) -> Option<(Vec3, T)> {
+    if let Some(found) = walk(problem, seed, TOLERANCE) {
+        return Some(found);
+    }
+    let mut d = seed;
+    for k in 1..=STAGES {
+        let eta_k = 1.0 + (problem.eta - 1.0) * k as f32 / STAGES as f32;
+        let stage = Problem {
+            eta: eta_k,
+            ..*problem
+        };
+        if k == STAGES {
+            return walk(&stage, d, TOLERANCE);
+        }
+        d = walk(&stage, d, STAGE_TOLERANCE)?.0;
+    }
+    None
+}
+
+/// The connection along the converged direction `d` leaving through `e`, with its measure
+/// (`exact`: the exact walk's linearisation at `d`); `None` unless the refracted ray heads for
+/// the light.
+fn connect(
+    problem: &Problem,
+    d: Vec3,
+    e: Exit,
+    n_light: Vec3,
+    exact: Option<&Linearised>,
+) -> Option<Connection> {
+    let to_light = problem.x2 - e.p;
     let dist = to_light.length();
     // Snell's law holds and the refracted ray really heads for the light.
     if e.out.dot(to_light) < dist * (1.0 - 1e-3) {
         return None;
     }
-    let jacobian = problem.measure(d, n_light, e.p, e.n)?;
+    let jacobian = problem.measure(d, n_light, e.p, e.n, exact)?;
     Some(Connection {
         d,
         exit: e,
