@@ -34,8 +34,13 @@ const FLOOR: f32 = -1.002;
 /// the origin, a black sky, and an orthographic camera looking down at the floor around the
 /// sphere, `size`² pixels at `spp`.
 fn floor_stage(x: f32, r: f32, size: u32, spp: u32) -> String {
+    shaped_floor_stage("Sphere(radius: 1.0)", x, r, size, spp)
+}
+
+/// [`floor_stage`] with another stone `shape`.
+fn shaped_floor_stage(shape: &str, x: f32, r: f32, size: u32, spp: u32) -> String {
     format!(
-        "(shape: Sphere(radius: 1.0), ground: Plane(height: {FLOOR}, albedo: Gray(0.6)),
+        "(shape: {shape}, ground: Plane(height: {FLOOR}, albedo: Gray(0.6)),
           environment: Constant(Gray(0.0)),
           lights: [Disc(center: ({x}, 4.0, 0.0), target: (0.0, 0.0, 0.0), radius: {r},
                         radiance: Gray(20.0))],
@@ -68,8 +73,24 @@ fn through_hit(w: &World, x0: Vec3, d: Vec3, eta: f32, c: Vec3, n: Vec3, r: f32)
 /// which only BSDF sampling produces) and the walks that found no connection.
 #[test]
 fn through_measure_integrates_to_the_solid_angle_the_walk_covers() {
+    through_measure("Sphere(radius: 1.0)");
+}
+
+/// (a) for the walk with the exact Jacobian (src/render/manifold/exact.rs): the unit sphere as a
+/// cabochon (two hemispherical domes), whose walks differentiate the entry refraction and the
+/// exit in closed form.
+#[test]
+fn exact_through_measure_integrates_to_the_solid_angle_the_walk_covers() {
+    through_measure("Cabochon(radius: (1.0, 1.0), height: 1.0, base: 1.0)");
+}
+
+/// (a) for the stone `shape` (the unit sphere, however it is described).
+fn through_measure(shape: &str) {
     let eta = 1.5;
-    let (_, w) = build(&gem("(ior: 1.5)", &floor_stage(1.2, 0.6, 8, 1)));
+    let (_, w) = build(&gem(
+        "(ior: 1.5)",
+        &shaped_floor_stage(shape, 1.2, 0.6, 8, 1),
+    ));
     let light = &w.areas[0];
     let (n, area) = (light.normal(), light.area());
     let c = Vec3::new(1.2, 4.0, 0.0);

@@ -2,7 +2,8 @@
 //! density of the direction (module docs in [`super`]).
 
 use super::ManifoldSetup;
-use super::walk::{Chain, last, solve};
+use super::chain::Chain;
+use super::walk::{last, solve};
 use crate::bsdf::fresnel;
 use crate::geometry::{Ray, offset_origin};
 use crate::platelet::PlateletId;

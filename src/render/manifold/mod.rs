@@ -27,12 +27,12 @@
 //! 5–6 % darker than BSDF sampling's; with this one they agree within noise). Newton's method on the two tangent coordinates of `d`,
 //! seeded with the straight line `x0 → x2`, a step bounded by [`MAX_STEP`] and halved while the
 //! residual grows, at most [`MAX_ITERATIONS`] iterations; if that fails, a continuation in the
-//! index from `η = 1` ([`solve`]). Out of a cabochon the Jacobian is exact at every iterate: the
+//! index from `η = 1` ([`solve`]). On a cabochon the Jacobian is exact at every iterate: the
 //! exit point's motion, the light direction's and the normal's through the domes' shape
-//! operator (`geometry::Curvature`), one trace per iteration and none for the measure. The
-//! other boundaries may be meshes or faceted solids whose curvature is not available in closed
-//! form, and a [`Chain::Through`] also moves its entry refraction: there the Jacobian is taken
-//! by forward differences once and carried by Broyden's updates. A solution
+//! operator (`geometry::Curvature`), and for a [`Chain::Through`] the entry point's and Snell's
+//! law's there; one chain traced per iteration and none for the measure. The other boundaries
+//! may be meshes or faceted solids whose curvature is not available in closed form: there the
+//! Jacobian is taken by forward differences once and carried by Broyden's updates. A solution
 //! must refract onto the light (the refracted ray heads for `x2`). Light points no refracted ray
 //! from `x0` reaches (near the boundary, many are: total internal reflection closes part of the
 //! sky) have no solution and contribute nothing, as they should; a reachable point the walk misses
@@ -61,20 +61,23 @@
 //! the body gets no walk from the floor (BSDF sampling alone finds those paths).
 //!
 //! Files: [`walk`] solves for the connection and its measure (`exact.rs` the walk with the
-//! exact Jacobian, `newton.rs` what both walks share); [`light`] turns a connection into a light
+//! exact Jacobian, `newton.rs` what both walks share, `chain.rs` the chains and the entry
+//! refraction); [`light`] turns a connection into a light
 //! sample and gives the density the MIS weight needs.
 
+mod chain;
 mod exact;
 pub mod light;
 mod newton;
 pub mod walk;
 
+pub use chain::{Chain, Entry};
 pub use light::{
     ManifoldLight, WALK_THRESHOLD, WalkNumbers, WalkVertex, density, sample_light, transmittance,
     walk_probability,
 };
 pub use newton::{MAX_ITERATIONS, MAX_STEP, TOLERANCE};
-pub use walk::{Chain, Connection, Entry, Exit, STAGES, exit, solve};
+pub use walk::{Connection, Exit, STAGES, exit, solve};
 
 use crate::light::Area;
 

@@ -1,52 +1,16 @@
 //! The manifold walk: Newton's method on the direction at the vertex, and the measure of the
 //! connection it finds (module docs in [`super`]).
 
+use super::chain::{Chain, Entry, entry};
 use super::exact::{self, Linearised};
 use super::newton::{MAX_HALVINGS, MAX_ITERATIONS, TOLERANCE, det, step, turn};
 use crate::bsdf::refract;
-use crate::geometry::{Fan, Frame, StoneHit, offset_origin};
+use crate::geometry::{Fan, Frame, StoneHit};
 use crate::render::world::World;
 use glam::{Vec2, Vec3};
 
 /// Finite-difference step of the constraint's Jacobian, radians.
 const FD_STEP: f32 = 1e-3;
-
-/// The chain of specular events between the vertex and the light that the walk solves for.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Chain {
-    /// From a vertex inside the body (a platelet, a medium point): one refraction out.
-    Out,
-    /// From a surface outside the body (the floor): a refraction into the body, then one out —
-    /// the light a small lamp focuses through the stone (a caustic).
-    Through,
-}
-
-impl Chain {
-    /// How many times the chain crosses the boundary (each a specular transmission).
-    pub fn crossings(self) -> u8 {
-        match self {
-            Chain::Out => 1,
-            Chain::Through => 2,
-        }
-    }
-}
-
-/// Where a [`Chain::Through`] path enters the body.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Entry {
-    /// The boundary point, world space.
-    pub p: Vec3,
-    /// Object-space point (for the surface map).
-    pub p_object: Vec3,
-    /// Distance from the vertex, world units.
-    pub t: f32,
-    /// Cosine between the direction outside and the shading normal (> 0).
-    pub cos_outside: f32,
-    /// The refracted direction inside (unit).
-    pub inside: Vec3,
-    /// Origin of the segment inside (the point moved off the boundary, inward).
-    pub origin: Vec3,
-}
 
 /// Where a direction from the vertex leaves the stone.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -81,28 +45,6 @@ pub struct Connection {
     pub dist: f32,
     /// `|dω0/dA2|`: solid angle at the vertex per unit light area, world units⁻².
     pub jacobian: f32,
-}
-
-/// The refraction into the body along direction `d` of the rays `from` the vertex outside; `None`
-/// if the ray misses the body or does not enter it there.
-fn entry(from: &Fan, d: Vec3, eta: f32) -> Option<Entry> {
-    let h = from.intersect(d, f32::INFINITY)?;
-    let c = -h.ns.dot(d);
-    if !(h.ng.dot(d) < 0.0 && c > 0.0) {
-        return None;
-    }
-    let inside = refract(-d, h.ns, eta)?;
-    if inside.dot(h.ng) >= 0.0 {
-        return None;
-    }
-    Some(Entry {
-        p: h.p,
-        p_object: h.p_object,
-        t: h.t,
-        cos_outside: c,
-        inside,
-        origin: offset_origin(h.p, h.ng, inside),
-    })
 }
 
 /// The chain's last boundary point along direction `d` of the rays `from` the vertex (where it
@@ -355,12 +297,15 @@ pub fn solve(
         eta,
         chain,
     };
-    // Out of a cabochon the walk takes the exact Jacobian (no finite differences); through
-    // any other stone, or through the body and out again, Broyden's updates.
-    if chain == Chain::Out && problem.from.has_shape_operator() {
-        let walk = |p: &Problem, seed, tol| exact::newton(&p.from, p.x2, p.eta, seed, tol);
+    // On a cabochon the walk takes the exact Jacobian (no finite differences); on any other
+    // stone Broyden's updates.
+    if problem.from.has_shape_operator() {
+        let stone = &world.stone;
+        let walk = |p: &Problem, seed, tol| {
+            exact::newton((stone, &p.from), (p.x2, p.eta, p.chain), seed, tol)
+        };
         let (d, lin) = continued(&problem, seed, walk)?;
-        let e = exit_of(lin.hit, d, eta, None)?;
+        let e = exit_of(lin.hit, lin.w, eta, lin.entry())?;
         return connect(&problem, d, e, n_light, Some(&lin));
     }
     let walk = |p: &Problem, seed, tol| p.newton(seed, tol).map(|d| (d, ()));
