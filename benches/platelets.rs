@@ -13,13 +13,22 @@
 //! Populations: `aventurine-glass` (8 000 / unit³, r 0.01–0.04, uniform orientation) and
 //! `oregon-sunstone` (800 / unit³, r 0.015–0.04, aligned to y with a 4° spread). Times are the
 //! benchmark thread's CPU time on 64-bit Linux (wall time elsewhere). Run with
-//! `cargo bench --bench platelets` (about 30 s); a filter narrows it, e.g.
+//! `cargo bench --bench platelets` (about 40 s); a filter narrows it, e.g.
 //! `cargo bench --bench platelets -- aventurine/first`.
+//!
+//! `manifold/…`: 512 manifold walks (`render::manifold::solve`, one refraction out) from random
+//! points inside a glass unit sphere (IOR 1.5) to random points on a disc light above it —
+//! `exact` with the sphere described as a cabochon (two hemispherical domes: the walk's
+//! Jacobian in closed form), `differences` with the sphere as a `Sphere` (a finite-difference
+//! Jacobian and Broyden's updates). The same geometry, so the ratio is the Jacobian's cost.
 
 use criterion::{Criterion, Throughput};
 use glam::Vec3;
 use lapidary::platelet::grid::intersect;
 use lapidary::platelet::{Orientation, Population};
+use lapidary::recipe::GemRecipe;
+use lapidary::render::World;
+use lapidary::render::manifold::{Chain, solve};
 use lapidary::sampler::Rng;
 use std::hint::black_box;
 use std::time::Duration;
@@ -80,7 +89,60 @@ fn populations() -> Vec<(&'static str, Population)> {
     vec![("aventurine", aventurine), ("oregon", oregon)]
 }
 
+/// A glass unit sphere described as `shape`, under a disc light of radius 0.5 at height 4.
+fn sphere_world(shape: &str) -> World {
+    let text = format!(
+        "(materials: {{ \"m\": (coats: [], base: Lambert(albedo: Gray(0.5))) }},
+          body: (ior: 1.5), surface: Body,
+          stage: (shape: {shape},
+                  lights: [Disc(center: (0.0, 4.0, 0.0), target: (0.0, 0.0, 0.0), radius: 0.5,
+                                radiance: Gray(20.0))]))"
+    );
+    let scene = GemRecipe::parse("bench.ron", &text)
+        .and_then(|r| r.compile())
+        .expect("bench recipe");
+    World::new(&scene).expect("bench world")
+}
+
+/// Manifold walks on the same sphere with the exact and the finite-difference Jacobian.
+fn walks(c: &mut Criterion<Clock>) {
+    let mut rng = Rng::new(0x3a1f);
+    let pairs: Vec<(Vec3, Vec3)> = (0..512)
+        .map(|_| {
+            let x0 = unit(&mut rng) * (0.9 * rng.uniform().cbrt());
+            let (r, phi) = (
+                0.5 * rng.uniform().sqrt(),
+                std::f32::consts::TAU * rng.uniform(),
+            );
+            (x0, Vec3::new(r * phi.cos(), 4.0, r * phi.sin()))
+        })
+        .collect();
+    let mut group = c.benchmark_group("manifold");
+    group.throughput(Throughput::Elements(pairs.len() as u64));
+    for (name, shape) in [
+        (
+            "exact",
+            "Cabochon(radius: (1.0, 1.0), height: 1.0, base: 1.0)",
+        ),
+        ("differences", "Sphere(radius: 1.0)"),
+    ] {
+        let world = sphere_world(shape);
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                let mut found = 0u32;
+                for &(x0, x2) in &pairs {
+                    found +=
+                        u32::from(solve(&world, x0, x2, Vec3::NEG_Y, 1.5, Chain::Out).is_some());
+                }
+                black_box(found)
+            })
+        });
+    }
+    group.finish();
+}
+
 fn bench(c: &mut Criterion<Clock>) {
+    walks(c);
     let rays = chords(0x18);
     for (name, pop) in populations() {
         let pops = std::slice::from_ref(&pop);
