@@ -363,18 +363,3 @@ fn connect(
         jacobian,
     })
 }
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn turn_moves_by_the_tangent_angle() {
-        let f = Frame::from_normal(Vec3::new(0.3, -0.2, 0.9).normalize());
-        let d = turn(&f, Vec2::new(1e-3, 0.0));
-        // The angle from its sine (acos near 1 loses the digits in f32).
-        let angle = d.cross(f.n).length().asin();
-        assert!((angle - 1e-3).abs() < 2e-6, "{angle}");
-        assert!(d.dot(f.s) > 0.0);
-    }
-}
