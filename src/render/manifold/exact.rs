@@ -15,6 +15,8 @@ pub(super) struct Linearised {
     pub c: Vec3,
     /// The exit hit `x1(d)`.
     pub hit: StoneHit,
+    /// The direction `d` at the vertex (world, unit).
+    pub d: Vec3,
     /// The direction arriving at `x1` from inside: `d` itself for [`Chain::Out`].
     pub w: Vec3,
     /// Where a [`Chain::Through`] enters the body, with what its derivative needs.
@@ -136,6 +138,7 @@ pub(super) fn linearise(
     Some(Linearised {
         c: v - n * vn,
         hit,
+        d,
         w,
         front,
         cos,
@@ -149,19 +152,23 @@ pub(super) fn linearise(
 }
 
 /// Newton's method on the direction at the vertex from `seed` (as the finite-difference walk,
-/// but with the exact Jacobian of [`linearise`] at every iterate). Returns the converged
-/// direction with the linearisation there (its hit is the exit point; its derivative the
-/// measure's `∂C/∂d`), or `None`.
+/// but with the exact Jacobian of [`linearise`] at every iterate). Returns the linearisation at
+/// the converged direction (its hit is the exit point; its derivative the measure's `∂C/∂d`),
+/// or `None`.
 ///
 /// # Arguments
 /// * `stone`, `from` – the stone and the rays from the vertex.
 /// * `x2`, `eta`, `chain` – the light point, the index ratio and the chain ([`linearise`]).
+/// * `tolerance` – converged when `|C| <` this.
 pub(super) fn newton(
-    (stone, from): (&Stone, &Fan),
-    (x2, eta, chain): (Vec3, f32, Chain),
+    stone: &Stone,
+    from: &Fan,
+    x2: Vec3,
+    eta: f32,
+    chain: Chain,
     seed: Vec3,
     tolerance: f32,
-) -> Option<(Vec3, Linearised)> {
+) -> Option<Linearised> {
     let linearise = |d: Vec3| linearise(stone, from, x2, eta, chain, d);
     let frame = Frame::from_normal(seed);
     let mut lin = linearise(seed)?;
@@ -172,7 +179,7 @@ pub(super) fn newton(
     let mut d = seed;
     for _ in 0..MAX_ITERATIONS {
         if lin.c.length() < tolerance {
-            return Some((d, lin));
+            return Some(lin);
         }
         // ∂d/∂a of `turn`: the frame's tangents projected off `d`, over |n + s a.x + t a.y|.
         let m = (frame.n + frame.s * a.x + frame.t * a.y).length();
@@ -197,7 +204,7 @@ pub(super) fn newton(
         let (trial, l) = accepted?;
         (a, d, lin) = (a + step, trial, l);
     }
-    (lin.c.length() < tolerance).then_some((d, lin))
+    (lin.c.length() < tolerance).then_some(lin)
 }
 
 #[cfg(test)]

@@ -301,26 +301,27 @@ pub fn solve(
     // stone Broyden's updates.
     if problem.from.has_shape_operator() {
         let stone = &world.stone;
-        let walk = |p: &Problem, seed, tol| {
-            exact::newton((stone, &p.from), (p.x2, p.eta, p.chain), seed, tol)
-        };
-        let (d, lin) = continued(&problem, seed, walk)?;
+        let walk =
+            |p: &Problem, seed, tol| exact::newton(stone, &p.from, p.x2, p.eta, p.chain, seed, tol);
+        let lin = continued(&problem, seed, walk, |l: &Linearised| l.d)?;
         let e = exit_of(lin.hit, lin.w, eta, lin.entry())?;
-        return connect(&problem, d, e, n_light, Some(&lin));
+        return connect(&problem, lin.d, e, n_light, Some(&lin));
     }
-    let walk = |p: &Problem, seed, tol| p.newton(seed, tol).map(|d| (d, ()));
-    let (d, ()) = continued(&problem, seed, walk)?;
+    let walk = |p: &Problem, seed, tol| p.newton(seed, tol);
+    let d = continued(&problem, seed, walk, |d: &Vec3| *d)?;
     let e = exit_from(world, &problem.from, d, eta, chain)?;
     connect(&problem, d, e, n_light, None)
 }
 
 /// Newton's method by `walk` from `seed`, else the continuation in the index from `η = 1`
-/// through [`STAGES`] stages ([`solve`]).
+/// through [`STAGES`] stages ([`solve`]); `dir` reads the converged direction off a walk's
+/// answer.
 fn continued<T>(
     problem: &Problem,
     seed: Vec3,
-    walk: impl Fn(&Problem, Vec3, f32) -> Option<(Vec3, T)>,
-) -> Option<(Vec3, T)> {
+    walk: impl Fn(&Problem, Vec3, f32) -> Option<T>,
+    dir: impl Fn(&T) -> Vec3,
+) -> Option<T> {
     if let Some(found) = walk(problem, seed, TOLERANCE) {
         return Some(found);
     }
@@ -334,7 +335,7 @@ fn continued<T>(
         if k == STAGES {
             return walk(&stage, d, TOLERANCE);
         }
-        d = walk(&stage, d, STAGE_TOLERANCE)?.0;
+        d = dir(&walk(&stage, d, STAGE_TOLERANCE)?);
     }
     None
 }
