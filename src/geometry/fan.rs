@@ -102,9 +102,12 @@ impl<'a> Fan<'a> {
     /// [`Fan::intersect`] (the same hit, bit for bit) with the surface's curvature there
     /// ([`Curvature`]); `None` for the curvature where [`Fan::has_shape_operator`] is false.
     #[inline]
-    pub fn intersect_curved(&self, dir: Vec3, t_max: f32) -> Option<(StoneHit, Option<Curvature>)> {
+    pub fn intersect_curved(&self, dir: Vec3, t_max: f32) -> Option<CurvedHit> {
         let Kind::Cabochon(c, org) = self.kind else {
-            return self.intersect(dir, t_max).map(|h| (h, None));
+            return self.intersect(dir, t_max).map(|hit| CurvedHit {
+                hit,
+                curvature: None,
+            });
         };
         if !valid_direction(dir, t_max) {
             return None;
@@ -127,11 +130,11 @@ impl<'a> Fan<'a> {
             Piece::Lower(u) => dome(c.lower_normal * u, c.lower_shape),
         };
         let p_object = c.shape.point(piece);
-        let h = self.finish(t, p_object, ng, ng, None)?;
-        curvature
-            .inv_len
-            .is_finite()
-            .then_some((h, Some(curvature)))
+        let hit = self.finish(t, p_object, ng, ng, None)?;
+        curvature.inv_len.is_finite().then_some(CurvedHit {
+            hit,
+            curvature: Some(curvature),
+        })
     }
 
     /// The world hit from the object-space point and the world normals; `None` where they
@@ -222,6 +225,15 @@ impl Stone {
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
         self.fan(ray.origin).occluded(ray.dir, t_max)
     }
+}
+
+/// A hit of [`Fan::intersect_curved`].
+#[derive(Clone, Copy, Debug)]
+pub struct CurvedHit {
+    /// The hit, as [`Fan::intersect`] gives it.
+    pub hit: StoneHit,
+    /// The surface's curvature there, where the stone knows it.
+    pub curvature: Option<Curvature>,
 }
 
 /// How the unit normal turns along the surface at a hit (its shape operator `S`, world

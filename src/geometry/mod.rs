@@ -21,7 +21,7 @@ pub mod stone;
 
 pub use cabochon::Cabochon;
 pub use clip::{FacetPlane, Hull};
-pub use fan::{Curvature, Fan};
+pub use fan::{Curvature, CurvedHit, Fan};
 pub use frame::Frame;
 pub use hit::{GeometryError, ShapeHit};
 pub use mesh::Mesh;

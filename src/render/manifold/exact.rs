@@ -5,7 +5,7 @@
 
 use super::chain::{Chain, Entry, entry_at};
 use super::newton::{MAX_HALVINGS, MAX_ITERATIONS, step, turn};
-use crate::geometry::{Curvature, Fan, Frame, Stone, StoneHit};
+use crate::geometry::{Curvature, CurvedHit, Fan, Frame, Stone, StoneHit};
 use glam::{Vec2, Vec3};
 
 /// The constraint at a direction with what its derivative needs ([`linearise`]).
@@ -101,10 +101,10 @@ pub(super) fn linearise(
     chain: Chain,
     d: Vec3,
 ) -> Option<Linearised> {
-    let (w, front, (hit, curvature)) = match chain {
+    let (w, front, CurvedHit { hit, curvature }) = match chain {
         Chain::Out => (d, None, from.intersect_curved(d, f32::INFINITY)?),
         Chain::Through => {
-            let (h, curvature) = from.intersect_curved(d, f32::INFINITY)?;
+            let CurvedHit { hit: h, curvature } = from.intersect_curved(d, f32::INFINITY)?;
             let entry = entry_at(h, d, eta)?;
             let cos_i = entry.cos_outside;
             // cos θt from the refracted direction, as `refract` made it.
