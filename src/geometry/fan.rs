@@ -15,6 +15,7 @@ use super::cabochon::{FrameOrigin, Piece};
 use super::hit::valid_direction;
 use super::placed::PlacedCabochon;
 use super::ray::Ray;
+use super::solid::Solid;
 use super::stone::{Stone, StoneHit};
 use glam::{Mat3A, Vec3};
 
@@ -92,11 +93,17 @@ impl<'a> Fan<'a> {
         }
     }
 
-    /// Whether [`Fan::intersect_curved`] knows the surface's curvature (a placed cabochon;
-    /// the other solids may be meshes with interpolated normals or have edges between facets).
+    /// Whether [`Fan::intersect_curved`] knows the surface's curvature: a placed cabochon's
+    /// domes and base, and the flat faces of a faceted stone or a slab (zero). A mesh's normals
+    /// are interpolated, and a sphere's walks keep the finite-difference Jacobian the tests
+    /// compare the exact one with.
     #[inline]
     pub fn has_shape_operator(&self) -> bool {
-        matches!(self.kind, Kind::Cabochon(..))
+        match self.kind {
+            Kind::Cabochon(..) => true,
+            Kind::Solid(_) => matches!(self.stone.solid(), Solid::Polytope(_) | Solid::Slab(_)),
+            Kind::Invalid => false,
+        }
     }
 
     /// [`Fan::intersect`] (the same hit, bit for bit) with the surface's curvature there
@@ -104,9 +111,10 @@ impl<'a> Fan<'a> {
     #[inline]
     pub fn intersect_curved(&self, dir: Vec3, t_max: f32) -> Option<CurvedHit> {
         let Kind::Cabochon(c, org) = self.kind else {
+            let flat = self.has_shape_operator().then_some(Curvature::FLAT);
             return self.intersect(dir, t_max).map(|hit| CurvedHit {
                 hit,
-                curvature: None,
+                curvature: flat,
             });
         };
         if !valid_direction(dir, t_max) {
@@ -119,13 +127,7 @@ impl<'a> Fan<'a> {
             (g.normalize_or_zero(), Curvature { field, inv_len })
         };
         let (ng, curvature) = match piece {
-            Piece::Base(_) => (
-                c.base_normal,
-                Curvature {
-                    field: Mat3A::ZERO,
-                    inv_len: 0.0,
-                },
-            ),
+            Piece::Base(_) => (c.base_normal, Curvature::FLAT),
             Piece::Upper(u) => dome(c.upper_normal * u, c.upper_shape),
             Piece::Lower(u) => dome(c.lower_normal * u, c.lower_shape),
         };
@@ -239,7 +241,7 @@ pub struct CurvedHit {
 /// How the unit normal turns along the surface at a hit (its shape operator `S`, world
 /// units⁻¹): `δn = S δx` for a displacement `δx` of the point along the surface. A dome's normal
 /// is `n = g/|g|` with `g = F x + const` (`F` the dome's `*_shape` matrix: the normal matrix
-/// times the world-to-frame map), so `S δx = (I − n nᵀ) F δx / |g|`; the flat base's is zero.
+/// times the world-to-frame map), so `S δx = (I − n nᵀ) F δx / |g|`; a flat face's is zero.
 #[derive(Clone, Copy, Debug)]
 pub struct Curvature {
     /// `F`, world units⁻¹ (zero on the flat base).
@@ -249,6 +251,12 @@ pub struct Curvature {
 }
 
 impl Curvature {
+    /// A flat face's: the normal does not turn.
+    pub const FLAT: Curvature = Curvature {
+        field: Mat3A::ZERO,
+        inv_len: 0.0,
+    };
+
     /// `δn = S δx` at the hit whose unit normal is `n`.
     #[inline]
     pub fn turn(&self, n: Vec3, dx: Vec3) -> Vec3 {

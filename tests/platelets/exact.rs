@@ -27,6 +27,18 @@ fn exact_walk_measure_integrates_to_the_refracted_solid_angle() {
     );
 }
 
+/// (b) for a box (flat faces: the exact Jacobian with zero curvature, as for a faceted stone),
+/// vertices near the middle, near the top face and near a side.
+#[test]
+fn exact_walk_measure_through_a_flat_face_integrates_to_the_refracted_solid_angle() {
+    let vertices = [
+        Vec3::new(0.0, 0.6, 0.0),
+        Vec3::new(0.2, 1.1, -0.1),
+        Vec3::new(-0.7, 0.5, 0.3),
+    ];
+    measure_integrates("Slab(size: (1.6, 1.2, 1.4))", &vertices);
+}
+
 /// The exact walk (a cabochon that is a unit sphere) and the finite-difference walk (the unit
 /// `Sphere`) against the connection solved in `f64` on the unit sphere in closed form (Newton
 /// with `f64` central differences from the walks' answer), for 2 000 random vertex–light-point

@@ -27,12 +27,14 @@
 //! 5–6 % darker than BSDF sampling's; with this one they agree within noise). Newton's method on the two tangent coordinates of `d`,
 //! seeded with the straight line `x0 → x2`, a step bounded by [`MAX_STEP`] and halved while the
 //! residual grows, at most [`MAX_ITERATIONS`] iterations; if that fails, a continuation in the
-//! index from `η = 1` ([`solve`]). On a cabochon the Jacobian is exact at every iterate: the
-//! exit point's motion, the light direction's and the normal's through the domes' shape
-//! operator (`geometry::Curvature`), and for a [`Chain::Through`] the entry point's and Snell's
-//! law's there; one chain traced per iteration and none for the measure. The other boundaries
-//! may be meshes or faceted solids whose curvature is not available in closed form: there the
-//! Jacobian is taken by forward differences once and carried by Broyden's updates. A solution
+//! index from `η = 1` ([`solve`]). On a cabochon, a faceted stone or a slab the Jacobian is
+//! exact at every iterate: the exit point's motion, the light direction's and the normal's
+//! through the surface's shape operator (`geometry::Curvature`: the domes', zero on flat faces),
+//! and for a [`Chain::Through`] the entry point's and Snell's law's there; one chain traced per
+//! iteration and none for the measure. A mesh's interpolated normals have no closed-form
+//! curvature, and the sphere keeps the finite-difference walk the tests compare the exact one
+//! with: there the Jacobian is taken by forward differences once and carried by Broyden's
+//! updates. A solution
 //! must refract onto the light (the refracted ray heads for `x2`). Light points no refracted ray
 //! from `x0` reaches (near the boundary, many are: total internal reflection closes part of the
 //! sky) have no solution and contribute nothing, as they should; a reachable point the walk misses
@@ -43,7 +45,7 @@
 //! geometry term). By the implicit function theorem on `C(d, x2) = 0`,
 //! `|dω0/dA2| = |det ∂C/∂x2| / |det ∂C/∂d|`: `∂C/∂x2 = −P (I − u uᵀ)/L` on the light's plane
 //! (`P` the tangential projection at `x1`, `L = |x2 − x1|`) in closed form, and `∂C/∂d` exact
-//! (a cabochon) or by central differences at the solution (tangent coordinates of `d` measure solid angle there).
+//! (where the walk is) or by central differences at the solution (tangent coordinates of `d` measure solid angle there).
 //! Without an interface (`η = 1`) this is exactly `cos θ_light / |x2 − x0|²` (tested), and through
 //! a glass sphere its integral over a light equals the solid angle of the refracted rays that
 //! reach it (tested by shooting).

@@ -297,8 +297,8 @@ pub fn solve(
         eta,
         chain,
     };
-    // On a cabochon the walk takes the exact Jacobian (no finite differences); on any other
-    // stone Broyden's updates.
+    // Where the stone knows its curvature the walk takes the exact Jacobian (no finite
+    // differences); elsewhere Broyden's updates.
     if problem.from.has_shape_operator() {
         let stone = &world.stone;
         let walk =
