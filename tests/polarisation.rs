@@ -370,13 +370,8 @@ fn the_dichroscope_shows_both_waves_side_by_side() {
         r#"(materials: {{}}, surface: Body,
             body: (ior: 1.62, crystal: Uniaxial(ne: 1.62, axis: (1.0, 0.0, 0.0),
                    pleochroism: (ordinary: Gray(0.2), extraordinary: Gray(0.8), distance: 0.5))),
-            stage: (preset: Dichroscope(), shape: Slab(size: (0.6, 0.5, 0.6)),
-                    transform: (translate: (0.0, 0.3, 0.0)),
-                    lights: [Rect(center: (0.0, -1.0, 0.0), target: (0.0, 0.0, 0.0),
-                                  size: (20.0, 20.0), radiance: Gray(1.0))],
-                    camera: Orthographic(from: (0.0, 5.0, 0.0), to: (0.0, 0.0, 0.0),
-                                         up: (0.0, 0.0, -1.0), height: 1.0),
-                    render: (width: {w}, height: {h}, spp: 16, max_depth: 16)))"#
+            stage: {})"#,
+        dichroscope_plate(w, h)
     ));
     assert!(s.stage.dichroscope && s.effects.on(Effect::Polarisation));
     let world = World::new(&s).expect("world");
@@ -431,4 +426,18 @@ fn polarised_crystal_renders_are_thread_count_independent() {
     let bits = |f: &Vec<[f32; 3]>| f.iter().flatten().map(|v| v.to_bits()).collect::<Vec<_>>();
     assert_eq!(bits(&films[0]), bits(&films[1]));
     assert!(films[0].iter().flatten().any(|v| *v > 0.0));
+}
+
+/// The dichroscope looking down at a 0.6 × 0.5 × 0.6 plate over a wide white light, `w × h`
+/// pixels at 16 spp: the stage of the dichroic plate tests.
+fn dichroscope_plate(w: usize, h: usize) -> String {
+    format!(
+        "(preset: Dichroscope(), shape: Slab(size: (0.6, 0.5, 0.6)),
+          transform: (translate: (0.0, 0.3, 0.0)),
+          lights: [Rect(center: (0.0, -1.0, 0.0), target: (0.0, 0.0, 0.0),
+                        size: (20.0, 20.0), radiance: Gray(1.0))],
+          camera: Orthographic(from: (0.0, 5.0, 0.0), to: (0.0, 0.0, 0.0),
+                               up: (0.0, 0.0, -1.0), height: 1.0),
+          render: (width: {w}, height: {h}, spp: 16, max_depth: 16))"
+    )
 }

@@ -74,6 +74,7 @@ impl Boundary {
 mod tests {
     use super::*;
     use crate::polarisation::boundary::Incident;
+    use crate::polarisation::boundary::tests::assert_reciprocal;
     use crate::polarisation::optics::Optics;
     use crate::polarisation::uniaxial::Uniaxial;
     use crate::sampler::Rng;
@@ -209,36 +210,7 @@ mod tests {
             let b = boundary(n, random_axes(&mut rng));
             let mut d = random_unit(&mut rng);
             d.z = -d.z.abs().max(0.05);
-            let d = d.normalize();
-            for mode in [Mode::S, Mode::P] {
-                let fwd = b
-                    .solve(Incident::Outside { dir: d, mode }, DVec3::X)
-                    .unwrap();
-                for j in [2, 3] {
-                    let w = fwd[j].wave;
-                    if !w.propagating() || fwd[j].power < 1e-9 {
-                        continue;
-                    }
-                    let back = b
-                        .solve(
-                            Incident::Inside {
-                                dir: -w.direction(),
-                                mode: w.mode,
-                            },
-                            DVec3::X,
-                        )
-                        .unwrap();
-                    let k = if mode == Mode::S { 0 } else { 1 };
-                    assert!(
-                        (back[k].power - fwd[j].power).abs() < 1e-7,
-                        "{mode:?}→{:?}: {} vs {}",
-                        w.mode,
-                        fwd[j].power,
-                        back[k].power
-                    );
-                    checked += 1;
-                }
-            }
+            checked += assert_reciprocal(&b, d.normalize());
         }
         assert!(checked > 2000, "{checked}");
     }

@@ -1,7 +1,7 @@
 //! Biaxial crystals (`crystal: Biaxial(…)`) in polarised renders: the white furnace, the
 //! polariscope's blinking and a trichroic plate's three colours in the dichroscope.
 
-use super::{compile, mean};
+use super::{compile, dichroscope_plate, mean};
 use lapidary::render::{Control, World, render_scene};
 use lapidary::scene::Effect;
 
@@ -91,13 +91,8 @@ fn the_dichroscope_shows_a_trichroic_crystals_three_colours() {
                        x_axis: {x_axis}, z_axis: {z_axis},
                        pleochroism: (alpha: Gray(0.8), beta: Gray(0.5), gamma: Gray(0.2),
                                      distance: 0.5))),
-                stage: (preset: Dichroscope(), shape: Slab(size: (0.6, 0.5, 0.6)),
-                        transform: (translate: (0.0, 0.3, 0.0)),
-                        lights: [Rect(center: (0.0, -1.0, 0.0), target: (0.0, 0.0, 0.0),
-                                      size: (20.0, 20.0), radiance: Gray(1.0))],
-                        camera: Orthographic(from: (0.0, 5.0, 0.0), to: (0.0, 0.0, 0.0),
-                                             up: (0.0, 0.0, -1.0), height: 1.0),
-                        render: (width: {w}, height: {h}, spp: 16, max_depth: 16)))"#
+                stage: {})"#,
+            dichroscope_plate(w, h)
         ));
         assert!(s.stage.dichroscope && s.effects.on(Effect::Polarisation));
         let world = World::new(&s).expect("world");
