@@ -1,7 +1,7 @@
 //! Biaxial crystals (`crystal: Biaxial(…)`) in polarised renders: the white furnace, the
 //! polariscope's blinking and a trichroic plate's three colours in the dichroscope.
 
-use super::{compile, dichroscope_plate, mean};
+use super::{compile, dichroscope_plate, furnace_sphere, mean};
 use lapidary::render::{Control, World, render_scene};
 use lapidary::scene::Effect;
 
@@ -15,16 +15,10 @@ fn biaxial_spheres_in_a_white_furnace() {
         (1.542, 1.548, 1.551, "(0.0, 1.0, 0.0)", "(1.0, 0.0, 0.0)"),
         (1.5, 1.65, 1.72, "(1.0, 1.0, 0.3)", "(-0.2, 0.4, 1.0)"),
     ] {
-        let s = compile(&format!(
-            r#"(materials: {{}}, surface: Body,
-                body: (ior: {ior}, crystal: Biaxial(beta: {beta}, gamma: {gamma},
-                                                     x_axis: {x_axis}, z_axis: {z_axis})),
-                stage: (shape: Sphere(radius: 1.0), ground: Off,
-                        environment: Constant(Gray(1.0)), lights: [],
-                        camera: Orthographic(from: (0.0, 0.0, 5.0), to: (0.0, 0.0, 0.0), height: 2.0),
-                        render: (width: 32, height: 32, spp: 64, max_depth: 64)))"#
+        let (got, se) = furnace_sphere(&format!(
+            "(ior: {ior}, crystal: Biaxial(beta: {beta}, gamma: {gamma},
+                                          x_axis: {x_axis}, z_axis: {z_axis}))"
         ));
-        let (got, se) = mean(&s);
         eprintln!("biaxial sphere {ior}/{beta}/{gamma}: {got:.5} ± {se:.5}");
         assert!(
             (got - 1.0).abs() < 0.01 + 5.0 * se,
