@@ -28,6 +28,11 @@
 use crate::sampler::mix64;
 use glam::{DVec3, IVec3, Vec3};
 
+mod block;
+
+/// Cell coordinates below this in magnitude are packed into one word by [`Voronoi::cell_id`].
+const LIMIT: i32 = 1 << 20;
+
 /// A Voronoi basis: `scale` is applied by the caller (positions are in cell units).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Voronoi {
@@ -86,7 +91,6 @@ impl Voronoi {
     /// rounds beyond that.
     #[inline]
     pub fn cell_id(&self, c: IVec3) -> u64 {
-        const LIMIT: i32 = 1 << 20;
         if c.abs().max_element() < LIMIT {
             let pack = |v: i32| u64::from((v + LIMIT) as u32);
             mix64(self.key ^ (pack(c.x) | pack(c.y) << 21 | pack(c.z) << 42))
@@ -113,23 +117,35 @@ impl Voronoi {
 
     /// Nearest feature point only (F1, its cell and id): the cheap lookup maps use to pick a
     /// cell. Agrees with [`Voronoi::sample`] on `f1`, `cell` and `id`.
+    ///
+    /// The 3×3×3 block is measured whole in SIMD lanes ([`block`](mod@block)) and its nearest point is the
+    /// first of the minimum distance in [`NEIGHBOURS`] order. That is the point a scan in that
+    /// order keeps while it skips every cell whose box is no nearer than the best so far (the
+    /// scalar path below, for cells beyond the packing range): rounding is monotone, so a point
+    /// in a box is never computed nearer than the box (each axis term `(q − x)²` of a point
+    /// with `q ≤ 0` is at least `x²`, with `q ≥ 1` at least `(1 − x)²`, summed in the same order).
     pub fn nearest(&self, p: Vec3) -> VoronoiNearest {
         let p = clamp_input(p);
         let base = p.floor();
         let local = p - base;
         let bc = IVec3::new(base.x as i32, base.y as i32, base.z as i32);
-        let (lo, hi) = (local * local, (DVec3::ONE - local) * (DVec3::ONE - local));
         let mut d1 = f64::INFINITY;
         let (mut c1, mut id1) = (bc, 0u64);
-        for &o in &NEIGHBOURS {
-            if box_distance_sq(o, lo, hi) >= d1 {
-                continue;
-            }
-            let c = bc + o;
-            let id = self.cell_id(c);
-            let d = (o.as_dvec3() + self.offset(id) - local).length_squared();
-            if d < d1 {
-                (d1, c1, id1) = (d, c, id);
+        if Voronoi::block_applies(bc) {
+            let n = self.block_nearest(bc, local);
+            (d1, c1, id1) = (n.d, bc + NEIGHBOURS[n.k], n.id);
+        } else {
+            let (lo, hi) = (local * local, (DVec3::ONE - local) * (DVec3::ONE - local));
+            for &o in &NEIGHBOURS {
+                if box_distance_sq(o, lo, hi) >= d1 {
+                    continue;
+                }
+                let c = bc + o;
+                let id = self.cell_id(c);
+                let d = (o.as_dvec3() + self.offset(id) - local).length_squared();
+                if d < d1 {
+                    (d1, c1, id1) = (d, c, id);
+                }
             }
         }
         // Shells beyond the 3×3×3 block can hold the nearest point only for high jitter.
