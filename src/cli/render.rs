@@ -255,13 +255,6 @@ pub fn run(args: &RenderArgs) -> Result<bool> {
              with --view, or put the camera in the recipe for a farm render"
         );
     }
-    if args.samples.is_some() && args.stokes {
-        // A part file carries the radiance's exact sums only: the merge would drop the AOVs.
-        bail!(
-            "--stokes with --samples: part renders do not carry the Stokes sums yet; render the \
-             whole image with --stokes"
-        );
-    }
     let (exr_path, png_path) = outputs(args)?;
     let mut plan = OutputPlan::new();
     plan.input(&args.recipe, "the recipe")?;

@@ -6,6 +6,7 @@
 //! in any viewer and `lapidary compare` reads it) plus:
 //! - the film's fixed-point sums ([`super::fixed`]) as 32-bit unsigned integer channels named
 //!   `raw.*`, exact: an `i128` is four words, least significant first (`raw.sum.R.0` … `.3`);
+//! - with `--stokes`, the Stokes vector's sums the same way (`raw.stokes.*`, [`stokes`]);
 //! - `lapidary.samples` (the range rendered, `A..B`; shorter than requested if a time limit
 //!   stopped it), `lapidary.samples_requested`, `lapidary.strategy` and `lapidary.exposure`.
 //!
@@ -25,6 +26,7 @@ use std::path::{Path, PathBuf};
 
 mod check;
 mod range;
+pub mod stokes;
 
 pub use self::check::{MAX_RENDER_TIME, check};
 pub use self::range::{MAX_SPP, format_range, parse_range};
@@ -121,15 +123,17 @@ fn words() -> Vec<Word> {
     out
 }
 
-/// The film's sums as exact integer channels.
+/// The film's sums (and its Stokes sums, if it has them) as exact integer channels.
 pub fn raw_channels(film: &Film) -> Vec<RawChannel> {
-    words()
+    let mut out: Vec<RawChannel> = words()
         .into_iter()
         .map(|(name, get)| RawChannel {
             name,
             data: film.pixels.iter().map(get).collect(),
         })
-        .collect()
+        .collect();
+    out.extend(stokes::raw_channels(film));
+    out
 }
 
 /// Rebuilds a film from its raw channels; the error names a missing or short channel.
@@ -185,6 +189,7 @@ pub fn film_from_raw(width: u32, height: u32, raw: &[RawChannel]) -> Result<Film
         p.depth_n = depth_n[i];
         p.material = material[i] as i32;
     }
+    film.stokes = stokes::from_raw(n, raw)?;
     Ok(film)
 }
 
@@ -324,6 +329,20 @@ pub fn merge(mut parts: Vec<Part>) -> Result<Merged, String> {
             }
         }
     }
+    for p in &parts[1..] {
+        if p.film.stokes.is_empty() != first.film.stokes.is_empty() {
+            let (with, without) = if p.film.stokes.is_empty() {
+                (first, p)
+            } else {
+                (p, first)
+            };
+            problems.push(format!(
+                "{} holds the Stokes sums (rendered with --stokes) but {} does not",
+                with.path.display(),
+                without.path.display()
+            ));
+        }
+    }
     let spp: u32 = first
         .attr("lapidary.spp")
         .parse()
@@ -381,6 +400,7 @@ pub fn merge(mut parts: Vec<Part>) -> Result<Merged, String> {
         for (a, b) in film.pixels.iter_mut().zip(&p.film.pixels) {
             a.merge(b);
         }
+        stokes::merge(&mut film.stokes, &p.film.stokes);
     }
     let render_time: f64 = parts
         .iter()
