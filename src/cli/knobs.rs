@@ -186,6 +186,23 @@ pub fn check_setting(setting: &str) -> Result<(), String> {
     Ok(())
 }
 
+/// `acc` with polarised transport forced on when `stokes` (`--stokes` of `render` and
+/// `preview`: the Stokes AOVs are measured by polarised transport); an error when the knobs turn
+/// it off.
+pub fn with_stokes(mut acc: Accuracy, stokes: bool) -> anyhow::Result<Accuracy> {
+    use crate::scene::Effect;
+    if stokes {
+        if acc.forced(Effect::Polarisation) == Some(false) {
+            anyhow::bail!(
+                "--stokes contradicts --polarised off: the Stokes AOVs are measured by polarised \
+                 transport"
+            );
+        }
+        acc.force(Effect::Polarisation, true);
+    }
+    Ok(acc)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -226,18 +226,8 @@ fn settings(args: &RenderArgs, scene: &mut Scene) {
 
 /// The accuracy knobs of the command line, with polarised transport forced on by `--stokes`.
 fn accuracy(args: &RenderArgs) -> Result<crate::scene::accuracy::Accuracy> {
-    use crate::scene::Effect;
-    let mut acc = args.knobs.accuracy().map_err(anyhow::Error::msg)?;
-    if args.stokes {
-        if acc.forced(Effect::Polarisation) == Some(false) {
-            bail!(
-                "--stokes contradicts --polarised off: the Stokes AOVs are measured by polarised \
-                 transport"
-            );
-        }
-        acc.force(Effect::Polarisation, true);
-    }
-    Ok(acc)
+    let acc = args.knobs.accuracy().map_err(anyhow::Error::msg)?;
+    super::knobs::with_stokes(acc, args.stokes)
 }
 
 /// Runs `lapidary render`; returns whether the render was interrupted by Ctrl-C or SIGTERM

@@ -199,6 +199,15 @@ impl StokesSums {
         }
     }
 
+    /// Adds another range's sums of the same pixel (exact: the order does not matter).
+    pub fn merge(&mut self, other: &StokesSums) {
+        for (a, b) in self.0.iter_mut().zip(&other.0) {
+            for (x, y) in a.iter_mut().zip(b) {
+                *x = x.wrapping_add(*y);
+            }
+        }
+    }
+
     /// The mean Stokes vector over `n` kept samples (0 without samples).
     pub fn mean(&self, n: u32) -> [[f32; 3]; 4] {
         let n = f64::from(n.max(1));

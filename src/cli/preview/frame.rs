@@ -26,6 +26,10 @@ pub enum Aov {
     Cells,
     /// Relative standard error of each pixel's mean (viridis, 0 → 10 %).
     Variance,
+    /// Stokes component `k` (0–3) of the light reaching the camera (`preview --stokes`): S0
+    /// tone-mapped as the colour; S1–S3 as their fraction of S0's luminance, `−1 … 1`, warm where
+    /// positive (horizontal, +45°, right-circular), cool where negative, black where unpolarised.
+    Stokes(usize),
 }
 
 impl Aov {
@@ -39,15 +43,24 @@ impl Aov {
             "material" => Aov::Material,
             "cells" => Aov::Cells,
             "variance" => Aov::Variance,
+            "s0" => Aov::Stokes(0),
+            "s1" => Aov::Stokes(1),
+            "s2" => Aov::Stokes(2),
+            "s3" => Aov::Stokes(3),
             _ => return None,
         })
     }
 }
 
 /// The image's PNG at the requested size (a quick low-resolution frame is enlarged, each pixel
-/// a block).
+/// a block). A Stokes view of an image without the Stokes sums is black.
 pub fn png(image: &Image, aov: Aov, tm: &ToneMap) -> Vec<u8> {
     let film = &image.film;
+    let stokes = |i: usize| {
+        film.stokes
+            .get(i)
+            .map_or([[0.0; 3]; 4], |s| s.mean(film.pixels[i].n))
+    };
     let (w, h) = (film.width, film.height);
     let max_depth = film
         .pixels
@@ -96,6 +109,20 @@ pub fn png(image: &Image, aov: Aov, tm: &ToneMap) -> Vec<u8> {
                 let rel = lum(v.map(f32::sqrt)) / lum(m).max(1e-6);
                 crate::image::heatmap::viridis((rel / 0.1).clamp(0.0, 1.0))
             }
+            Aov::Stokes(0) => crate::image::tone_map_pixel(stokes(i)[0], tm),
+            Aov::Stokes(k) => {
+                let s = stokes(i);
+                let lum = |c: [f32; 3]| 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+                let q = lum(s[k.min(3)]) / lum(s[0]).max(1e-12);
+                let q = if q.is_finite() {
+                    q.clamp(-1.0, 1.0)
+                } else {
+                    0.0
+                };
+                let warm = [1.0, 0.55, 0.1].map(|c| c * q.max(0.0));
+                let cool = [0.1, 0.6, 1.0].map(|c| c * (-q).max(0.0));
+                unit([0, 1, 2].map(|c| warm[c] + cool[c]))
+            }
         }
     };
     let s = image.scale.max(1);
@@ -139,6 +166,9 @@ pub fn command(recipe: &Path, image: &Image, knobs: &Knobs, out: Option<&Path>) 
     );
     if let Some(v) = image.view.to_arg() {
         cmd += &format!(" --view {v}");
+    }
+    if image.scene.stage.stokes {
+        cmd += " --stokes";
     }
     cmd += &knob_flags(knobs);
     if let Some(o) = out {

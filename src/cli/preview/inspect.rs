@@ -59,6 +59,12 @@ pub fn inspect(image: &Image, x: u32, y: u32) -> Option<Value> {
         "hit": "sky", "point": null, "normal": null, "facet_normal": null,
         "material": null, "map": [], "cells": [], "glitter_cell": null, "inside": null,
         "facet": null,
+        // The mean Stokes vector per colour channel (S0…S3, each R, G, B) with `--stokes`.
+        "stokes": image
+            .film
+            .stokes
+            .get((fy * image.film.width + fx) as usize)
+            .map(|st| st.mean(p.n)),
     });
     let surface = &image.scene.surface;
     match hit {

@@ -69,6 +69,10 @@ pub struct PreviewArgs {
     /// `--tev` alone: 127.0.0.1:14158, tev's default).
     #[arg(long, num_args = 0..=1, default_missing_value = "", value_parser = tev::parse_address)]
     pub tev: Option<SocketAddr>,
+    /// Also measure the Stokes vector of the light reaching the camera (polarised transport, as
+    /// `render --stokes`): the page shows S0–S3 and the export writes them as AOVs.
+    #[arg(long)]
+    pub stokes: bool,
     /// Accuracy knobs (override the recipe's), as for `render`.
     #[command(flatten)]
     pub knobs: super::knobs::KnobArgs,
@@ -104,7 +108,10 @@ pub fn start(args: &PreviewArgs) -> Result<Running> {
     std::fs::metadata(&args.recipe)
         .with_context(|| format!("{}: cannot read the recipe", args.recipe.display()))?;
     let knobs = crate::scene::Knobs {
-        accuracy: args.knobs.accuracy().map_err(anyhow::Error::msg)?,
+        accuracy: super::knobs::with_stokes(
+            args.knobs.accuracy().map_err(anyhow::Error::msg)?,
+            args.stokes,
+        )?,
         ..Default::default()
     };
     let ip = args.bind.unwrap_or(IpAddr::V4(Ipv4Addr::LOCALHOST));
@@ -140,6 +147,7 @@ pub fn start(args: &PreviewArgs) -> Result<Running> {
         knobs.clone(),
         args.threads.map(|t| t as usize),
         Duration::from_secs_f64(args.idle),
+        args.stokes,
     );
     if let Ok(mut w) = shared.watcher.lock() {
         *w = watch_inputs(&shared);

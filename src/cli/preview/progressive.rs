@@ -76,6 +76,13 @@ pub(super) fn refine(
         for (acc, p) in film.pixels.iter_mut().zip(&part.pixels) {
             acc.merge(p);
         }
+        if film.stokes.is_empty() {
+            film.stokes.clone_from(&part.stokes);
+        } else {
+            for (acc, s) in film.stokes.iter_mut().zip(&part.stokes) {
+                acc.merge(s);
+            }
+        }
         rate = paths as f64 / secs.max(1e-6);
         spent += secs;
         done = end;

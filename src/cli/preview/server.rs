@@ -219,6 +219,8 @@ pub fn status_json(ctx: &Context, s: &super::state::State) -> Value {
         // calibration, or the last image before a knob change.
         "draft": image.is_some_and(|i| i.knobs != s.knobs),
         "spp": image.map_or(0, |i| i.spp),
+        // Whether the image carries the Stokes vector (the page offers S0–S3 then).
+        "stokes": image.is_some_and(|i| !i.film.stokes.is_empty()),
         "target_spp": r.spp,
         "paths_per_second": s.paths_per_second,
         "elapsed": s.generation_start.elapsed().as_secs_f64(),
@@ -307,12 +309,20 @@ fn frame_png(ctx: &Context, query: &[(String, String)]) -> Reply {
         return error(
             400,
             format!(
-                "aov `{a}`: expected color, albedo, normal, depth, material, cells or variance"
+                "aov `{a}`: expected color, albedo, normal, depth, material, cells, variance or \
+                 s0 … s3 (with --stokes)"
             ),
         );
     };
     let image = ctx.shared.lock().image.clone();
     match image {
+        Some(i) if matches!(aov, Aov::Stokes(_)) && i.film.stokes.is_empty() => error(
+            404,
+            format!(
+                "aov `{a}`: this image has no Stokes vector (run `lapidary preview --stokes`; \
+                 polarised transport must stay on)"
+            ),
+        ),
         Some(i) => reply(200, "image/png", frame::png(&i, aov, &tm)),
         None => error(404, "no image yet"),
     }

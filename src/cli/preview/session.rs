@@ -160,6 +160,7 @@ fn load(shared: &Shared) -> Result<Loaded, String> {
     match crate::cli::load::load_scene(path, &knobs.accuracy, None) {
         Ok(mut l) => {
             knobs.apply_render(&mut l.scene);
+            l.scene.stage.stokes = shared.stokes;
             Ok(Loaded {
                 inputs: Inputs::of_loaded(path, &l.recipe),
                 scene: l.scene,

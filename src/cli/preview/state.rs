@@ -185,6 +185,9 @@ pub struct Shared {
     pub threads: Option<usize>,
     /// How long the worker renders with no page asking ([`CLIENT_TIMEOUT`] by default).
     pub idle: Duration,
+    /// Whether renders measure the Stokes vector (`preview --stokes`): the page then shows the
+    /// S0–S3 views and the export writes the AOVs.
+    pub stokes: bool,
     /// The folder watcher (kept alive here; the worker adds folders when the inputs change).
     pub(super) watcher: Mutex<Option<notify::RecommendedWatcher>>,
 }
@@ -197,6 +200,7 @@ impl Shared {
         knobs: Knobs,
         threads: Option<usize>,
         idle: Duration,
+        stokes: bool,
     ) -> Arc<Shared> {
         let now = Instant::now();
         Arc::new(Shared {
@@ -228,6 +232,7 @@ impl Shared {
             recipe,
             threads,
             idle,
+            stokes,
             watcher: Mutex::new(None),
         })
     }

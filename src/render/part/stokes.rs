@@ -108,11 +108,7 @@ pub fn check(film: &Film) -> Option<String> {
 /// Adds `other`'s Stokes sums to `sums` (exact: the order of parts does not matter).
 pub fn merge(sums: &mut [StokesSums], other: &[StokesSums]) {
     for (a, b) in sums.iter_mut().zip(other) {
-        for (ra, rb) in a.0.iter_mut().zip(&b.0) {
-            for (x, y) in ra.iter_mut().zip(rb) {
-                *x = x.wrapping_add(*y);
-            }
-        }
+        a.merge(b);
     }
 }
 
