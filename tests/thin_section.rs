@@ -125,3 +125,59 @@ fn a_thin_plate_in_white_light_shows_the_michel_levy_colours() {
         }
     }
 }
+
+/// Each index its own dispersion law (`ne_dispersion`): under a 450 nm line a plate's
+/// retardation is `d (n_e(λ) − n_o(λ))` at that wavelength, not the d line's birefringence.
+/// The plate of `plate` with ε = 1.600 of Abbe number 20 (a two-term Cauchy law through ε at
+/// 587.56 nm, computed here from the Abbe definition) and ω = 1.544 constant: 100 nm of
+/// retardation at the d line become 157 nm at 450 nm, which passes `sin²(π R/λ)` = 0.79 of a
+/// half-wave plate's light (without the law, 0.41: the second scene). Tolerance as in the line
+/// test.
+#[test]
+fn an_index_with_its_own_law_sets_the_retardation_at_each_wavelength() {
+    let (lambda, v_e, n_e, n_o, r_d) = (450.0f64, 20.0f64, 1.600f64, 1.544f64, 100.0f64);
+    let unit_nm = r_d / (0.5 * (n_e - n_o));
+    let um = |l: f64| l * 1e-3;
+    let (f, c, d) = (486.13, 656.27, 587.56);
+    let b = (n_e - 1.0) / (v_e * (1.0 / um(f).powi(2) - 1.0 / um(c).powi(2)));
+    let n_e_at = n_e + b * (1.0 / um(lambda).powi(2) - 1.0 / um(d).powi(2));
+    let r = 0.5 * unit_nm * (n_e_at - n_o);
+    let want = (std::f64::consts::PI * r / lambda).sin().powi(2);
+    assert!(want > 0.5, "{r} nm: {want}");
+    let half = plate(lambda / 2.0, Some(lambda), false, true);
+    let text = |law: &str| {
+        format!(
+            r#"(materials: {{}}, surface: Body,
+                body: (ior: {n_o}, crystal: Uniaxial(ne: {n_e}, axis: (1.0, 0.0, 1.0), {law}
+                       thin_section: (unit_nm: {unit_nm}))),
+                stage: (shape: Slab(size: (0.6, 0.5, 0.6)), transform: (translate: (0.0, 0.3, 0.0)),
+                        ground: Off, environment: Constant(Gray(0.0)),
+                        lights: [Rect(center: (0.0, -1.0, 0.0), target: (0.0, 0.0, 0.0),
+                                      size: (20.0, 20.0), radiance: Gray(1.0), polariser: 0.0,
+                                      line: (wavelength: {lambda}, fwhm: 0.5))],
+                        camera: Orthographic(from: (0.0, 5.0, 0.0), to: (0.0, 0.0, 0.0),
+                                             up: (0.0, 0.0, -1.0), height: 1.0),
+                        analyser: 0.0,
+                        render: (width: 24, height: 24, spp: 256, max_depth: 16)))"#
+        )
+    };
+    let own = compile(&text("ne_dispersion: Abbe(20.0),"));
+    assert!(own.effects.on(Effect::Spectral));
+    let luminance = |m: [f64; 3]| m[0] + m[1] + m[2];
+    let (h, h_se) = plate_mean(&half);
+    let (h, h_se) = (luminance(h), luminance(h_se));
+    for (scene, want) in [
+        (own, want),
+        (
+            compile(&text("")),
+            (std::f64::consts::PI * r_d / lambda).sin().powi(2),
+        ),
+    ] {
+        let (m, se) = plate_mean(&scene);
+        let (m, se) = (luminance(m), luminance(se));
+        let got = m / h;
+        let tol = 0.006 + 5.0 * (se / h + want * h_se / h);
+        eprintln!("{got:.4} (sin² πR/λ {want:.4}, ± {tol:.4})");
+        assert!((got - want).abs() <= tol, "{got} vs {want}");
+    }
+}

@@ -327,7 +327,11 @@ impl Compiler<'_> {
             },
         };
         let (platelets, platelet_materials) = self.platelets(desc, body_index, at.unwrap_or(0))?;
-        let crystal = match desc.crystal.as_ref().map(|c| c.compile(desc.ior)) {
+        let crystal = match desc
+            .crystal
+            .as_ref()
+            .map(|c| c.compile(desc.ior, dispersion))
+        {
             None => None,
             Some(Ok(c)) => Some(c),
             Some(Err((key, m))) => {
@@ -382,6 +386,14 @@ impl Compiler<'_> {
                 self.effects.turn_on(
                     Effect::Spectral,
                     format!("body.crystal.thin_section ({}:{})", e.file, e.line),
+                );
+            }
+            if let Some(key) = desc.crystal.as_ref().and_then(|c| c.own_dispersion()) {
+                let d = r.source.find_from(at.unwrap_or(0), &[key, ":"]).or(at);
+                let e = r.source.error(d, "");
+                self.effects.turn_on(
+                    Effect::Spectral,
+                    format!("body.crystal.{key} ({}:{})", e.file, e.line),
                 );
             }
             if body.dispersion.is_some() {

@@ -11,9 +11,13 @@
 //!     pleochroism: Some((alpha: …, beta: …, gamma: …, distance: 1.0))),
 //! crystal: Uniaxial(ne: 1.553, axis: (1.0, 0.0, 0.0),    // a quartz plate …
 //!     thin_section: Some((unit_nm: 15000.0))),          // … 15 µm per object unit, coherent
+//! crystal: Uniaxial(ne: 1.5534, axis: (0.0, 1.0, 0.0),   // each index its own dispersion
+//!     ne_dispersion: Some(Abbe(68.5))),                 // (ω's is the body's `dispersion`)
 //! ```
 
 use super::color::ColorDesc;
+use super::dispersion::DispersionDesc;
+use crate::bsdf::dispersion::Ior;
 use crate::color::Rgb;
 use serde::{Deserialize, Deserializer, Serialize};
 
@@ -31,10 +35,13 @@ pub enum CrystalDesc {
     /// the optic axis polarised along it meet the extraordinary index `ne` (ε), every other
     /// polarisation the ordinary `ior` (ω).
     Uniaxial {
-        /// Extraordinary index ε, 1.0001 ..= 4 (with a `dispersion`, at the d line; the
-        /// birefringence ε − ω is kept at every wavelength).
+        /// Extraordinary index ε, 1.0001 ..= 4 (at the d line when there is dispersion).
         #[serde(deserialize_with = "ne_range")]
         ne: f32,
+        /// ε's own dispersion law (as the body's `dispersion`, through `ne` at the d line);
+        /// default: the birefringence ε − ω at the d line kept at every wavelength.
+        #[serde(default)]
+        ne_dispersion: Option<DispersionDesc>,
         /// The optic axis in the stone's object space (relative to the cut), any non-zero
         /// length.
         #[serde(deserialize_with = "super::surface::axis_check")]
@@ -50,13 +57,20 @@ pub enum CrystalDesc {
     /// along the principal axis X meets the body's `ior` (n_α), along Y `beta` (n_β), along Z
     /// `gamma` (n_γ), with `ior ≤ beta ≤ gamma`.
     Biaxial {
-        /// n_β, 1.0001 ..= 4, at least the body's `ior` (with a `dispersion`, at the d line;
-        /// n_β − n_α is kept at every wavelength).
+        /// n_β, 1.0001 ..= 4, at least the body's `ior` (at the d line when there is
+        /// dispersion).
         #[serde(deserialize_with = "beta_range")]
         beta: f32,
-        /// n_γ, 1.0001 ..= 4, at least `beta` (n_γ − n_α kept likewise).
+        /// n_γ, 1.0001 ..= 4, at least `beta`.
         #[serde(deserialize_with = "gamma_range")]
         gamma: f32,
+        /// n_β's own dispersion law (through `beta` at the d line); default: n_β − n_α at the
+        /// d line kept at every wavelength.
+        #[serde(default)]
+        beta_dispersion: Option<DispersionDesc>,
+        /// n_γ's own dispersion law (through `gamma`); default: n_γ − n_α kept likewise.
+        #[serde(default)]
+        gamma_dispersion: Option<DispersionDesc>,
         /// The X axis (n_α's vibration direction) in the stone's object space, any non-zero
         /// length.
         #[serde(deserialize_with = "super::surface::axis_check")]
@@ -195,14 +209,45 @@ pub fn biaxial_axes(
     Ok([xv, zv.cross(xv), zv])
 }
 
+/// Largest principal index a crystal's dispersion law may reach.
+const N_MAX: f32 = 4.0;
+
+/// Wavelengths (nm) at which a crystal's laws are checked against each other: the visible range
+/// the spectral variant samples, every 5 nm.
+fn checked_wavelengths() -> impl Iterator<Item = f32> {
+    (360..=830).step_by(5).map(|l| l as f32)
+}
+
+/// The index `d + offset` at `lambda` when `law` is `None` (the d line's difference kept).
+fn index_at(law: Option<Ior>, body: Option<Ior>, n_d: f32, ior: f32, lambda: f32) -> f32 {
+    match (law, body) {
+        (Some(l), _) => l.at(lambda),
+        (None, Some(b)) => b.at(lambda) + (n_d - ior),
+        (None, None) => n_d,
+    }
+}
+
 impl CrystalDesc {
-    /// The crystal of a body of index `ior`, or the keyword the error is at and what is wrong.
-    pub fn compile(&self, ior: f32) -> Result<crate::scene::body::Crystal, (&'static str, String)> {
+    /// The crystal of a body of index `ior` (its law `body`, if dispersive), or the keyword the
+    /// error is at and what is wrong. Each principal index with its own law must keep its order
+    /// against the others at every visible wavelength (a uniaxial ε − ω its sign, at least 10⁻⁴
+    /// from zero; biaxial n_α ≤ n_β ≤ n_γ).
+    pub fn compile(
+        &self,
+        ior: f32,
+        body: Option<Ior>,
+    ) -> Result<crate::scene::body::Crystal, (&'static str, String)> {
         use crate::scene::body::{Crystal, Indices};
         let pleochroism = |m: String| ("pleochroism", format!("body.crystal.{m}"));
+        let law = |d: &Option<DispersionDesc>, key: &'static str, n: f32| {
+            d.map(|d| d.law_of(&format!("body.crystal.{key}"), n, N_MAX))
+                .transpose()
+                .map_err(|m| (key, m))
+        };
         match self {
             CrystalDesc::Uniaxial {
                 ne,
+                ne_dispersion,
                 axis,
                 pleochroism: p,
                 thin_section,
@@ -211,11 +256,32 @@ impl CrystalDesc {
                     None => (Rgb::ZERO, Rgb::ZERO),
                     Some(r) => r.map_err(pleochroism)?,
                 };
+                let ne_law = law(ne_dispersion, "ne_dispersion", *ne)?;
+                if ne_law.is_some() {
+                    let sign = (*ne - ior).signum();
+                    for l in checked_wavelengths() {
+                        let o = body.map_or(ior, |b| b.at(l));
+                        let d = index_at(ne_law, body, *ne, ior, l) - o;
+                        if !(d * sign >= 1e-4) {
+                            return Err((
+                                "ne_dispersion",
+                                format!(
+                                    "body.crystal.ne_dispersion: ε − ω is {:+.5} at 587.56 nm \
+                                     but {d:+.5} at {l} nm: the laws must keep the \
+                                     birefringence's sign, at least 0.0001 from zero, over \
+                                     360 ..= 830 nm",
+                                    *ne - ior
+                                ),
+                            ));
+                        }
+                    }
+                }
                 Ok(Crystal {
                     indices: Indices::Uniaxial {
                         ne: *ne,
                         axis: glam::Vec3::new(axis.0, axis.1, axis.2).normalize(),
                     },
+                    laws: [ne_law, None],
                     sigma: [o, e, Rgb::ZERO],
                     thin_nm: thin_section.as_ref().map(|t| t.unit_nm),
                 })
@@ -223,6 +289,8 @@ impl CrystalDesc {
             CrystalDesc::Biaxial {
                 beta,
                 gamma,
+                beta_dispersion,
+                gamma_dispersion,
                 x_axis,
                 z_axis,
                 pleochroism: p,
@@ -233,15 +301,64 @@ impl CrystalDesc {
                     None => [Rgb::ZERO; 3],
                     Some(r) => r.map_err(pleochroism)?,
                 };
+                let laws = [
+                    law(beta_dispersion, "beta_dispersion", *beta)?,
+                    law(gamma_dispersion, "gamma_dispersion", *gamma)?,
+                ];
+                if laws.iter().any(Option::is_some) {
+                    for l in checked_wavelengths() {
+                        let a = body.map_or(ior, |b| b.at(l));
+                        let b = index_at(laws[0], body, *beta, ior, l);
+                        let g = index_at(laws[1], body, *gamma, ior, l);
+                        if !(a <= b && b <= g) {
+                            // n_α > n_β can only come of β's law; n_β > n_γ of γ's, or of β's
+                            // when γ has none.
+                            let key = if a > b || laws[1].is_none() {
+                                "beta_dispersion"
+                            } else {
+                                "gamma_dispersion"
+                            };
+                            return Err((
+                                key,
+                                format!(
+                                    "body.crystal.{key}: at {l} nm the indices are {a:.5} / \
+                                     {b:.5} / {g:.5}: they must keep n_α ≤ n_β ≤ n_γ over \
+                                     360 ..= 830 nm"
+                                ),
+                            ));
+                        }
+                    }
+                }
                 Ok(Crystal {
                     indices: Indices::Biaxial {
                         beta: *beta,
                         gamma: *gamma,
                         axes,
                     },
+                    laws,
                     sigma,
                     thin_nm: thin_section.as_ref().map(|t| t.unit_nm),
                 })
+            }
+        }
+    }
+
+    /// The recipe key of the first principal index given its own dispersion law, if any.
+    pub fn own_dispersion(&self) -> Option<&'static str> {
+        match self {
+            CrystalDesc::Uniaxial { ne_dispersion, .. } => {
+                ne_dispersion.is_some().then_some("ne_dispersion")
+            }
+            CrystalDesc::Biaxial {
+                beta_dispersion,
+                gamma_dispersion,
+                ..
+            } => {
+                if beta_dispersion.is_some() {
+                    Some("beta_dispersion")
+                } else {
+                    gamma_dispersion.is_some().then_some("gamma_dispersion")
+                }
             }
         }
     }
@@ -262,6 +379,71 @@ mod tests {
         let (at, msg) =
             biaxial_axes(1.5, 1.55, 1.6, (1.0, 0.0, 0.0), (1.0, 0.05, 0.0)).unwrap_err();
         assert!(at == "z_axis" && msg.contains("within 5°"), "{msg}");
+    }
+
+    /// An index with its own law keeps it (through its d-line value); laws that would swap the
+    /// indices' order somewhere in 360 ..= 830 nm are refused, naming the key and the wavelength.
+    #[test]
+    fn own_dispersion_laws_are_kept_and_their_order_checked() {
+        use crate::bsdf::dispersion::LAMBDA_D;
+        let uni = |law: Option<DispersionDesc>| CrystalDesc::Uniaxial {
+            ne: 1.553,
+            ne_dispersion: law,
+            axis: (0.0, 0.0, 1.0),
+            pleochroism: None,
+            thin_section: None,
+        };
+        let c = uni(Some(DispersionDesc::Abbe(68.5)))
+            .compile(1.544, None)
+            .unwrap();
+        let law = c.laws[0].unwrap();
+        assert!((law.at(LAMBDA_D) - 1.553).abs() < 1e-5 && law.at(450.0) > 1.555);
+        assert_eq!(c.laws[1], None);
+        assert_eq!(uni(None).compile(1.544, None).unwrap().laws, [None, None]);
+        assert_eq!(
+            uni(Some(DispersionDesc::Abbe(68.5))).own_dispersion(),
+            Some("ne_dispersion")
+        );
+        // A strongly dispersive ω (Abbe 12) overtakes a weakly dispersive ε in the blue.
+        let body = Ior::from_abbe(1.544, 12.0);
+        let (key, msg) = uni(Some(DispersionDesc::Abbe(200.0)))
+            .compile(1.544, body)
+            .unwrap_err();
+        assert_eq!(key, "ne_dispersion");
+        assert!(msg.contains("sign") && msg.contains(" nm"), "{msg}");
+        // A law out of its own range is named with the crystal's key.
+        let (key, msg) = uni(Some(DispersionDesc::Abbe(1.0)))
+            .compile(1.544, None)
+            .unwrap_err();
+        assert!(
+            key == "ne_dispersion" && msg.contains("body.crystal.ne_dispersion"),
+            "{msg}"
+        );
+
+        let bi = |b: Option<DispersionDesc>, g: Option<DispersionDesc>| CrystalDesc::Biaxial {
+            beta: 1.5480,
+            gamma: 1.5600,
+            beta_dispersion: b,
+            gamma_dispersion: g,
+            x_axis: (1.0, 0.0, 0.0),
+            z_axis: (0.0, 0.0, 1.0),
+            pleochroism: None,
+            thin_section: None,
+        };
+        let ok = bi(None, Some(DispersionDesc::Abbe(40.0)))
+            .compile(1.542, None)
+            .unwrap();
+        assert!(ok.laws[0].is_none() && ok.laws[1].is_some());
+        // β dispersing far more than γ crosses it in the blue: γ's order is broken by β's law.
+        let (key, msg) = bi(Some(DispersionDesc::Abbe(10.0)), None)
+            .compile(1.542, None)
+            .unwrap_err();
+        assert_eq!(key, "beta_dispersion");
+        assert!(msg.contains("n_α ≤ n_β ≤ n_γ"), "{msg}");
+        let (key, _) = bi(None, Some(DispersionDesc::Abbe(200.0)))
+            .compile(1.542, Ior::from_abbe(1.542, 10.0))
+            .unwrap_err();
+        assert_eq!(key, "gamma_dispersion");
     }
 
     #[test]

@@ -33,19 +33,25 @@ impl DispersionDesc {
     /// or what is wrong with the law (every visible wavelength must see an index in
     /// `1 <.. n_max`).
     pub fn law(self, ior: f32, n_max: f32) -> Result<Ior, String> {
+        self.law_of("body.dispersion", ior, n_max)
+    }
+
+    /// [`DispersionDesc::law`] of the index the recipe names `what` (its errors begin with it:
+    /// `body.dispersion`, `body.crystal.ne_dispersion`, …), whose value at the d line is `ior`.
+    pub fn law_of(self, what: &str, ior: f32, n_max: f32) -> Result<Ior, String> {
         let law = match self {
             DispersionDesc::Abbe(v) => {
                 if !(5.0..=200.0).contains(&v) {
                     return Err(format!(
-                        "body.dispersion: Abbe number {v} is out of range: allowed 5 ..= 200"
+                        "{what}: Abbe number {v} is out of range: allowed 5 ..= 200"
                     ));
                 }
-                Ior::from_abbe(ior, v).ok_or("body.dispersion: Abbe needs ior > 1")?
+                Ior::from_abbe(ior, v).ok_or_else(|| format!("{what}: Abbe needs an index > 1"))?
             }
             DispersionDesc::Cauchy { b, c } => {
                 if !(0.0..=0.1).contains(&b) || !(0.0..=0.01).contains(&c) {
                     return Err(format!(
-                        "body.dispersion: Cauchy b {b} µm², c {c} µm⁴ out of range: allowed \
+                        "{what}: Cauchy b {b} µm², c {c} µm⁴ out of range: allowed \
                          b 0 ..= 0.1, c 0 ..= 0.01"
                     ));
                 }
@@ -62,7 +68,7 @@ impl DispersionDesc {
                     || c.iter().any(|v| !(0.0..=1000.0).contains(v))
                 {
                     return Err(format!(
-                        "body.dispersion: Sellmeier b {b:?}, c {c:?} out of range: allowed \
+                        "{what}: Sellmeier b {b:?}, c {c:?} out of range: allowed \
                          each B 0 ..= 10, each C 0 ..= 1000 µm²"
                     ));
                 }
@@ -70,9 +76,8 @@ impl DispersionDesc {
                 let n_d = law.at(LAMBDA_D);
                 if (n_d - ior).abs() > 1e-3 {
                     return Err(format!(
-                        "body.dispersion: the Sellmeier law gives {n_d:.5} at 587.56 nm but \
-                         ior is {}: they must agree within 0.001",
-                        ior
+                        "{what}: the Sellmeier law gives {n_d:.5} at 587.56 nm but the index \
+                         it describes is {ior} there: they must agree within 0.001"
                     ));
                 }
                 law
@@ -85,19 +90,19 @@ impl DispersionDesc {
             let n2 = law.n_squared(l as f32);
             if !n2.is_finite() {
                 return Err(format!(
-                    "body.dispersion: the law has a resonance at {l} nm (n² is not finite): \
+                    "{what}: the law has a resonance at {l} nm (n² is not finite): \
                      {allowed}"
                 ));
             }
             if n2 < 0.0 {
                 return Err(format!(
-                    "body.dispersion: the law gives n² = {n2:.4} < 0 at {l} nm: it has no real \
+                    "{what}: the law gives n² = {n2:.4} < 0 at {l} nm: it has no real \
                      index there; {allowed}"
                 ));
             }
             if n2 < 1.0 {
                 return Err(format!(
-                    "body.dispersion: the law gives n² = {n2:.4} < 1 (n = {:.4}) at {l} nm: \
+                    "{what}: the law gives n² = {n2:.4} < 1 (n = {:.4}) at {l} nm: \
                      {allowed}",
                     n2.sqrt()
                 ));
@@ -105,7 +110,7 @@ impl DispersionDesc {
             let n = law.at(l as f32);
             if !(n > 1.0 && n <= n_max) {
                 return Err(format!(
-                    "body.dispersion: the law gives n = {n} at {l} nm: {allowed}"
+                    "{what}: the law gives n = {n} at {l} nm: {allowed}"
                 ));
             }
         }

@@ -159,7 +159,7 @@ where
     // The normal pointing out of the stone.
     let facing = if n.dot(wo) > 0.0 { n } else { -n };
     let normal = if outside { facing } else { -facing };
-    let crystal_optics = crystal.at(no);
+    let crystal_optics = crystal.at(no, S::wavelength_nm(lambda, 0));
     // A biaxial boundary's normal made unit in f64 (an f32 normal is unit to 6e-8 only), so
     // that a reversed wave's tangential component repeats the adjoint's and the event solves
     // the crystal's quartic once (`boundary::Roots`); the uniaxial closed forms keep theirs.
@@ -250,7 +250,7 @@ pub(super) fn pleochroic_transmittance<S: Spectral>(
     if let Some(nm) = crystal.thin_nm {
         return thin_section::<S>(crystal, nm, pol, rows, dir, t, lambda);
     }
-    let optics = crystal.at(f64::from(crystal.no));
+    let optics = crystal.at(f64::from(crystal.no), None);
     let optics = match (crystal.biaxial, optics) {
         // The uniaxial extraordinary index as the d line's f32 sum (as it always was).
         (None, Optics::Uniaxial(x)) => Optics::Uniaxial(Uniaxial {
@@ -317,12 +317,23 @@ fn thin_section<S: Spectral>(
     t: f32,
     lambda: &S::Wavelengths,
 ) -> S {
-    let optics = crystal.at(f64::from(crystal.no));
+    let optics = crystal.at(f64::from(crystal.no), None);
     let ray = dir.as_dvec3();
     let [m1, m2] = optics.modes();
     let x1 = optics.field(ray, m1).as_vec3();
-    let retardation =
-        f64::from(t) * f64::from(nm_per_unit) * (optics.index(ray, m2) - optics.index(ray, m1));
+    // The retardation `d (n₂ − n₁)` at the d line, and at each channel's wavelength where an
+    // index has its own law (the body's index there from its law, if dispersive).
+    let path_nm = f64::from(t) * f64::from(nm_per_unit);
+    let retardation_d = path_nm * (optics.index(ray, m2) - optics.index(ray, m1));
+    let own_laws = crystal.laws.iter().any(Option::is_some);
+    let retardation = |nm: Option<f32>| match nm {
+        Some(l) if own_laws => {
+            let n = crystal.body_law.map_or(crystal.no, |b| b.at(l));
+            let o = crystal.at(f64::from(n), Some(l));
+            path_nm * (o.index(ray, m2) - o.index(ray, m1))
+        }
+        _ => retardation_d,
+    };
     let sigma = match &optics {
         // The ordinary wave absorbs σ_ω, the extraordinary σ_ω cos² θ + σ_ε sin² θ (its wave
         // normal is the ray here).
@@ -347,8 +358,9 @@ fn thin_section<S: Spectral>(
         } else {
             (0.0, 0.0)
         };
-        let nm = S::wavelength_nm(lambda, c).unwrap_or(RGB_NM[c]);
-        let delta = std::f64::consts::TAU * retardation / f64::from(nm);
+        let own = S::wavelength_nm(lambda, c);
+        let nm = own.unwrap_or(RGB_NM[c]);
+        let delta = std::f64::consts::TAU * retardation(own) / f64::from(nm);
         Mueller::diagonal_jones(
             C::from(f64::from((-0.5 * a1 * t).exp())),
             C::from_polar(f64::from((-0.5 * a2 * t).exp()), delta),

@@ -163,6 +163,12 @@ pub struct CrystalOptics {
     /// A thin section: nanometres of crystal per world unit (its two waves add coherently, its
     /// boundary refracts as an isotropic one of index `no`); `None`: a gem.
     pub thin_nm: Option<f32>,
+    /// Own dispersion laws of the indices beyond the body's (uniaxial `[ε, —]`, biaxial
+    /// `[n_β, n_γ]`; `None`: the d line's difference is kept).
+    pub laws: [Option<crate::bsdf::dispersion::Ior>; 2],
+    /// The body's own law (`None`: not dispersive), for a thin section's retardation at each
+    /// wavelength when an index has its own law.
+    pub body_law: Option<crate::bsdf::dispersion::Ior>,
 }
 
 impl CrystalOptics {
@@ -171,18 +177,23 @@ impl CrystalOptics {
         !self.sigma.iter().all(|s| s.is_black())
     }
 
-    /// The optics at the wavelength where the body's index is `n` (the other principal indices
-    /// keep their differences from it).
-    pub fn at(&self, n: f64) -> crate::polarisation::optics::Optics {
+    /// The optics at wavelength `lambda_nm` (`None`: the d line, the RGB variant), where the
+    /// body's index is `n`: an index with its own law takes the law's value there, the others
+    /// keep their differences from `n` at the d line.
+    pub fn at(&self, n: f64, lambda_nm: Option<f32>) -> crate::polarisation::optics::Optics {
         use crate::polarisation::{biaxial::Biaxial, optics::Optics, uniaxial::Uniaxial};
+        let index = |k: usize, offset: f32| match (self.laws[k], lambda_nm) {
+            (Some(law), Some(l)) => f64::from(law.at(l)),
+            _ => n + f64::from(offset),
+        };
         match self.biaxial {
             None => Optics::Uniaxial(Uniaxial {
                 no: n,
-                ne: n + f64::from(self.birefringence),
+                ne: index(0, self.birefringence),
                 axis: self.axis.as_dvec3(),
             }),
             Some(([b, g], axes)) => Optics::Biaxial(Biaxial {
-                n: [n, n + f64::from(b), n + f64::from(g)],
+                n: [n, index(0, b), index(1, g)],
                 axes: axes.map(|a| a.as_dvec3()),
             }),
         }
@@ -275,9 +286,9 @@ impl World {
         // `crate::polarisation::transport`); otherwise BSDF sampling alone finds those lights.
         let polarised = scene.effects.on(Effect::Polarisation);
         let crystal = (polarised && shows_body)
-            .then(|| body.and_then(|b| b.crystal.map(|c| (b.ior, c))))
+            .then(|| body.and_then(|b| b.crystal.map(|c| (b.ior, b.dispersion, c))))
             .flatten()
-            .map(|(ior, c)| {
+            .map(|(ior, body_law, c)| {
                 // Coefficients per object unit become per world unit (the stage's scale).
                 let scale = stage
                     .to_world
@@ -296,6 +307,8 @@ impl World {
                         biaxial: None,
                         sigma,
                         thin_nm,
+                        laws: c.laws,
+                        body_law,
                     },
                     Indices::Biaxial { beta, gamma, axes } => {
                         // Orthonormal again in world space (Gram–Schmidt, X kept).
@@ -309,6 +322,8 @@ impl World {
                             biaxial: Some(([beta - ior, gamma - ior], [x, z.cross(x), z])),
                             sigma,
                             thin_nm,
+                            laws: c.laws,
+                            body_law,
                         }
                     }
                 }

@@ -49,6 +49,10 @@ pub struct Body {
 pub struct Crystal {
     /// Its indices beyond the body's `ior` and its axes.
     pub indices: Indices,
+    /// Own dispersion laws of the indices beyond the body's (uniaxial `[ε, —]`, biaxial
+    /// `[n_β, n_γ]`); `None`: that index keeps its difference from the body's index at the d
+    /// line at every wavelength.
+    pub laws: [Option<Ior>; 2],
     /// Absorption per object unit on top of the medium's, per principal wave: uniaxial
     /// `[ω, ε across the axis, 0]`; biaxial `[α, β, γ]` (light vibrating along X, Y, Z).
     pub sigma: [Rgb; 3],
