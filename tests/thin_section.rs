@@ -163,6 +163,21 @@ fn an_index_with_its_own_law_sets_the_retardation_at_each_wavelength() {
     };
     let own = compile(&text("ne_dispersion: Abbe(20.0),"));
     assert!(own.effects.on(Effect::Spectral));
+    // An own law alone turns spectral transport on, and `lapidary info` names it.
+    let gem = compile(
+        r#"(materials: {}, surface: Body,
+            body: (ior: 1.544, crystal: Uniaxial(ne: 1.553, axis: (0.0, 1.0, 0.0),
+                                                 ne_dispersion: Abbe(68.5))),
+            stage: (shape: Sphere(radius: 1.0)))"#,
+    );
+    let (why, _) = gem
+        .effects
+        .reason(Effect::Spectral)
+        .expect("spectral is on");
+    assert!(
+        why.starts_with("body.crystal.ne_dispersion (thin_section.ron:3"),
+        "{why}"
+    );
     let luminance = |m: [f64; 3]| m[0] + m[1] + m[2];
     let (h, h_se) = plate_mean(&half);
     let (h, h_se) = (luminance(h), luminance(h_se));
