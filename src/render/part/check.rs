@@ -161,21 +161,28 @@ fn check_sums(film: &Film, samples: &Range<u32>) -> Vec<String> {
     let taken = u64::from(samples.end - samples.start);
     let mut out = Vec::new();
     for rule in RULES {
-        let mut broken = film
+        let broken = film
             .pixels
             .iter()
             .enumerate()
             .filter_map(|(i, p)| rule(p, taken).map(|m| (i, m)));
-        if let Some((i, m)) = broken.next() {
-            let w = film.width.max(1) as usize;
-            let more = broken.count();
-            let others = if more > 0 {
-                format!(" (and {more} more pixels)")
-            } else {
-                String::new()
-            };
-            out.push(format!("pixel ({}, {}){others}: {m}", i % w, i / w));
-        }
+        out.extend(first_broken(film, broken));
     }
     out
+}
+
+/// The first pixel of `broken` (index and what is wrong) with how many more there are, or `None`.
+pub(super) fn first_broken(
+    film: &Film,
+    mut broken: impl Iterator<Item = (usize, String)>,
+) -> Option<String> {
+    let (i, m) = broken.next()?;
+    let w = film.width.max(1) as usize;
+    let more = broken.count();
+    let others = if more > 0 {
+        format!(" (and {more} more pixels)")
+    } else {
+        String::new()
+    };
+    Some(format!("pixel ({}, {}){others}: {m}", i % w, i / w))
 }

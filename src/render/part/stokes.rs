@@ -78,7 +78,7 @@ pub fn check(film: &Film) -> Option<String> {
         return None;
     }
     let limit = fixed::radiance(fixed::RADIANCE_LIMIT) as u128;
-    let mut broken = film
+    let broken = film
         .pixels
         .iter()
         .zip(&film.stokes)
@@ -87,22 +87,14 @@ pub fn check(film: &Film) -> Option<String> {
             let most = u128::from(p.n).saturating_mul(limit);
             s.0.iter().flatten().any(|v| v.unsigned_abs() > most)
         })
-        .map(|(i, _)| i);
-    let i = broken.next()?;
-    let w = film.width.max(1) as usize;
-    let more = broken.count();
-    let others = if more > 0 {
-        format!(" (and {more} more pixels)")
-    } else {
-        String::new()
-    };
-    Some(format!(
-        "pixel ({}, {}){others}: `raw.stokes` beyond what {} kept samples of at most 2^60 can add \
-         up to",
-        i % w,
-        i / w,
-        film.pixels[i].n
-    ))
+        .map(|(i, (p, _))| {
+            let m = format!(
+                "`raw.stokes` beyond what {} kept samples of at most 2^60 can add up to",
+                p.n
+            );
+            (i, m)
+        });
+    super::check::first_broken(film, broken)
 }
 
 /// Adds `other`'s Stokes sums to `sums` (exact: the order of parts does not matter).
