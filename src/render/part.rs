@@ -256,7 +256,8 @@ impl Part {
             })
             .and_then(|s| parse_range(s).map_err(at))?;
         let film = film_from_raw(image.width, image.height, &raw).map_err(at)?;
-        let problems = check(&image, &film, &samples);
+        let mut problems = check(&image, &film, &samples);
+        problems.extend(stokes::check(&film));
         if !problems.is_empty() {
             return Err(problems.into_iter().map(at).collect::<Vec<_>>().join("\n"));
         }

@@ -93,7 +93,6 @@ pub fn check(image: &ExrImage, film: &Film, samples: &Range<u32>) -> Vec<String>
         )),
     }
     out.extend(check_sums(film, samples));
-    out.extend(super::stokes::check(film));
     out
 }
 
