@@ -11,6 +11,7 @@
 #[macro_use]
 mod ranged;
 pub mod body;
+mod body_compiler;
 pub mod color;
 mod compile;
 pub mod crystal;

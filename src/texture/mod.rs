@@ -22,6 +22,10 @@ pub mod perlin;
 pub mod simplify;
 pub mod voronoi;
 
+/// The instruction set the texture kernels (the Voronoi block, the octave lanes) are compiled for,
+/// detected once.
+pub(crate) static SIMD: std::sync::LazyLock<pulp::Arch> = std::sync::LazyLock::new(pulp::Arch::new);
+
 pub use bump::{FacetBump, Tilt};
 pub use explain::{MapDecision, MapExplanation, MapStep};
 pub use field::{FieldId, FieldNode, FieldTable};

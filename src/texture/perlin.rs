@@ -249,9 +249,6 @@ impl Octaves {
 /// Octaves a fractal sum evaluates at once: eight `f64` lanes fill an AVX-512 register.
 pub const OCTAVE_LANES: usize = 8;
 
-/// The instruction set [`octave_noises`] is compiled for, detected once.
-static ARCH: std::sync::LazyLock<pulp::Arch> = std::sync::LazyLock::new(pulp::Arch::new);
-
 /// The noises of octaves `first + i` of `octaves` at `p` (`perlin(p · freqs[i] + offset, seed)`,
 /// [`Octaves::octave`]'s seed and offset) for every lane, compiled for the widest instruction set
 /// this machine has (AVX-512, AVX2 or the x86-64 baseline, chosen at run time by `pulp`) and kept
@@ -284,7 +281,7 @@ fn octave_noises(
             out
         }
     }
-    ARCH.dispatch(Kernel(octaves, p, first, freqs))
+    crate::texture::SIMD.dispatch(Kernel(octaves, p, first, freqs))
 }
 
 #[cfg(test)]

@@ -52,6 +52,24 @@ impl Aov {
     }
 }
 
+/// The page's display settings: `exposure` in stops (−30 ..= 30, default 0) and the tone curve
+/// (`filmic`, the default, or `clamp`); the error says what is wrong and what is allowed.
+pub fn tone_map(exposure: Option<&str>, curve: Option<&str>) -> Result<ToneMap, String> {
+    let exposure = match exposure {
+        None => 0.0,
+        Some(v) => match v.parse::<f32>() {
+            Ok(e) if (-30.0..=30.0).contains(&e) => e,
+            _ => return Err(format!("exposure `{v}`: expected stops in -30..=30")),
+        },
+    };
+    let curve = match curve.unwrap_or("filmic") {
+        "filmic" => Curve::Filmic,
+        "clamp" => Curve::Clamp,
+        other => return Err(format!("tonemap `{other}`: expected filmic or clamp")),
+    };
+    Ok(ToneMap { exposure, curve })
+}
+
 /// The image's PNG at the requested size (a quick low-resolution frame is enlarged, each pixel
 /// a block). A Stokes view of an image without the Stokes sums is black.
 pub fn png(image: &Image, aov: Aov, tm: &ToneMap) -> Vec<u8> {

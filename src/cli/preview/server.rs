@@ -11,7 +11,7 @@
 use super::frame::{self, Aov};
 use super::http::{Request, Response};
 use super::state::{MAX_PIXELS, MAX_SPP, Shared};
-use crate::image::{Curve, ToneMap};
+use crate::image::ToneMap;
 use serde_json::{Value, json};
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -274,29 +274,7 @@ fn status(ctx: &Context, req: &Request, query: &[(String, String)]) -> Reply {
 }
 
 fn tone_map(query: &[(String, String)]) -> Result<ToneMap, Reply> {
-    let exposure = match text(query, "exposure") {
-        None => 0.0,
-        Some(v) => match v.parse::<f32>() {
-            Ok(e) if (-30.0..=30.0).contains(&e) => e,
-            _ => {
-                return Err(error(
-                    400,
-                    format!("exposure `{v}`: expected stops in -30..=30"),
-                ));
-            }
-        },
-    };
-    let curve = match text(query, "tonemap").unwrap_or("filmic") {
-        "filmic" => Curve::Filmic,
-        "clamp" => Curve::Clamp,
-        other => {
-            return Err(error(
-                400,
-                format!("tonemap `{other}`: expected filmic or clamp"),
-            ));
-        }
-    };
-    Ok(ToneMap { exposure, curve })
+    frame::tone_map(text(query, "exposure"), text(query, "tonemap")).map_err(|m| error(400, m))
 }
 
 fn frame_png(ctx: &Context, query: &[(String, String)]) -> Reply {

@@ -13,13 +13,9 @@
 use super::{LIMIT, NEIGHBOURS, Voronoi};
 use crate::sampler::mix64;
 use glam::{DVec3, IVec3};
-use std::sync::LazyLock;
 
 /// Lanes of the block: the 27 cells padded to a multiple of eight `f64` lanes.
 pub(super) const LANES: usize = 32;
-
-/// The instruction set the block is compiled for, detected once.
-static ARCH: LazyLock<pulp::Arch> = LazyLock::new(pulp::Arch::new);
 
 /// [`NEIGHBOURS`] per axis, padded with the home cell (padding lanes are never read).
 const OFFSETS: [[i32; LANES]; 3] = {
@@ -105,7 +101,7 @@ impl Voronoi {
                 self.basis.block_lanes(self.bc, self.local).nearest()
             }
         }
-        ARCH.dispatch(Kernel {
+        crate::texture::SIMD.dispatch(Kernel {
             basis: self,
             bc,
             local,
