@@ -24,6 +24,10 @@ use lapidary::scene::{Accuracy, Effect, Scene};
 #[path = "polarisation/biaxial.rs"]
 mod biaxial;
 
+/// Energy balance across a crystal's boundary: the radiance invariant.
+#[path = "polarisation/etendue.rs"]
+mod etendue;
+
 fn compile(text: &str) -> Scene {
     GemRecipe::parse("polarisation.ron", text)
         .unwrap_or_else(|e| panic!("{e}"))
@@ -149,7 +153,7 @@ fn white_furnace_stays_white_and_unpolarised() {
                             camera: Orthographic(from: (0.0, 0.0, 5.0), to: (0.0, 0.0, 0.0),
                                                  height: 2.0),
                             {a}
-                            render: (width: 32, height: 32, spp: 64, max_depth: 64)))"#
+                            render: (width: 32, height: 32, spp: 64, max_depth: 1024)))"#
             ));
             let s = forced(&s, true);
             let want = if analyser.is_some() { 0.5 } else { 1.0 };
@@ -251,9 +255,12 @@ fn calcite_doubles_and_polarises_the_image() {
     }
 }
 
-/// A lossless calcite sphere in a white unpolarised furnace reads 1 (equilibrium), within its
-/// noise and the radiance-scaling approximation across the boundary (`crystal.rs`: the
-/// walk-off's share of the invariant is left out), which this bounds at 1 %.
+/// A lossless calcite sphere in a white unpolarised furnace reads 1 (equilibrium), within 5
+/// standard errors and 0.1 % for the light still trapped at depth 1 024: a wave converted on
+/// reflection can circle the sphere under total internal reflection for hundreds of bounces (at
+/// depth 64 the sphere read 0.996). A furnace does not test the radiance invariant (a path's
+/// radiance scalings telescope from sky to sky whatever they are); the energy balance in
+/// `polarisation/etendue.rs` does.
 #[test]
 fn calcite_sphere_in_a_white_furnace() {
     for axis in ["(0.0, 1.0, 0.0)", "(1.0, 1.0, 0.3)"] {
@@ -262,7 +269,7 @@ fn calcite_sphere_in_a_white_furnace() {
         ));
         eprintln!("calcite sphere, axis {axis}: {got:.5} ± {se:.5}");
         assert!(
-            (got - 1.0).abs() < 0.01 + 5.0 * se,
+            (got - 1.0).abs() < 1e-3 + 5.0 * se,
             "axis {axis}: {got} ± {se}"
         );
     }
@@ -437,7 +444,7 @@ fn dichroscope_plate(w: usize, h: usize) -> String {
 }
 
 /// A unit sphere of clear `body` in a white furnace (constant sky 1, no floor, no lights), seen
-/// whole by an orthographic camera, 32² pixels × 64 spp, depth 64: the image's mean and its
+/// whole by an orthographic camera, 32² pixels × 64 spp, depth 1 024: the image's mean and its
 /// standard error.
 fn furnace_sphere(body: &str) -> (f64, f64) {
     mean(&compile(&format!(
@@ -445,6 +452,6 @@ fn furnace_sphere(body: &str) -> (f64, f64) {
             stage: (shape: Sphere(radius: 1.0), ground: Off,
                     environment: Constant(Gray(1.0)), lights: [],
                     camera: Orthographic(from: (0.0, 0.0, 5.0), to: (0.0, 0.0, 0.0), height: 2.0),
-                    render: (width: 32, height: 32, spp: 64, max_depth: 64)))"#
+                    render: (width: 32, height: 32, spp: 64, max_depth: 1024)))"#
     )))
 }

@@ -16,12 +16,14 @@
 //! from each wave; the weights then use the physical problem's Jones amplitudes and powers, so
 //! the estimate stays unbiased whatever the sampling.
 //!
-//! Radiance changes by `(n_to / n_from)²` across a refraction (Veach 1997, eq. 5.12), with the
-//! waves' phase indices; in an anisotropic medium the exact invariant also involves the walk-off
-//! angle, which this leaves out (an error of order `ρ²`, below 1 % for calcite's 6°).
+//! Radiance changes by `n_to² / n_from²` across a refraction (Veach 1997, eq. 5.12), where a
+//! crystal wave's `n²` is its radiance index [`etendue::index2`] — the inverse Gaussian
+//! curvature of its wave-vector surface, the exact invariant of an anisotropic medium — rather
+//! than its phase index's square.
 
 use super::biaxial::Roots;
 use super::boundary::{Boundary, Incident, Mode, Outgoing};
+use super::etendue;
 use super::optics::Optics;
 use super::transport::PathPolarisation;
 use glam::DVec3;
@@ -37,7 +39,9 @@ pub struct CrystalStep {
     pub weight: f64,
     /// The choice's probability.
     pub prob: f64,
-    /// Index of the new segment's wave over the old one's (1 for a reflection on the outside).
+    /// Radiance index ([`etendue::index2`]'s square root) of the new segment's wave over the old
+    /// one's (1 for a reflection on the outside): Russian roulette divides the radiance scaling
+    /// out by its square.
     pub eta: f64,
     /// Whether the path crossed the boundary.
     pub crossed: bool,
@@ -183,14 +187,15 @@ pub fn from_outside(
     let t_exit = phys[0].power + phys[1].power;
     let st = stokes(phys[0].amplitude, phys[1].amplitude);
     let measured = dot4(w, st);
-    let index = DVec3::new(adj.wave.k[0].re, adj.wave.k[1].re, adj.wave.k[2].re).length();
-    let scale = (b.n1 / index).powi(2);
+    let k = DVec3::new(adj.wave.k[0].re, adj.wave.k[1].re, adj.wave.k[2].re);
+    let index2 = etendue::index2(&b.crystal, k, adj.wave.mode);
+    let scale = b.n1 * b.n1 / index2;
     enter_wave(p, &adj, ray_down);
     Some(CrystalStep {
         wi: ray_down,
         weight: t_exit * measured * 0.5 * scale / prob,
         prob,
-        eta: index / b.n1,
+        eta: index2.sqrt() / b.n1,
         crossed: true,
     })
     .filter(|c| c.weight.is_finite() && c.weight >= 0.0)
@@ -229,6 +234,7 @@ pub fn from_inside(
     let choice = pick(&shares, u.1)?;
     let prob = shares[choice] / shares.iter().sum::<f64>();
     let index_own = b.crystal.index(k_up, mode);
+    let index2_own = etendue::index2(&b.crystal, index_own * k_up, mode);
     if choice == 0 {
         // In from outside along −wi: the Jones row into this wave, per unit incident power.
         let wi = if adj[0].power >= adj[1].power {
@@ -272,9 +278,9 @@ pub fn from_inside(
         p.normal = glam::Vec3::ZERO;
         return Some(CrystalStep {
             wi,
-            weight: 2.0 * analyser[0] * (index_own / b.n1).powi(2) / prob,
+            weight: 2.0 * analyser[0] * index2_own / (b.n1 * b.n1) / prob,
             prob,
-            eta: b.n1 / index_own,
+            eta: b.n1 / index2_own.sqrt(),
             crossed: true,
         })
         .filter(|c| c.weight.is_finite());
@@ -291,13 +297,14 @@ pub fn from_inside(
         &mut roots,
     )?;
     let r = phys[b.crystal.slot(mode)].power;
-    let index_k = DVec3::new(o.wave.k[0].re, o.wave.k[1].re, o.wave.k[2].re).length();
+    let k = DVec3::new(o.wave.k[0].re, o.wave.k[1].re, o.wave.k[2].re);
+    let index2_k = etendue::index2(&b.crystal, k, o.wave.mode);
     enter_wave(p, &o, -ray);
     Some(CrystalStep {
         wi: ray,
-        weight: r * (index_own / index_k).powi(2) / prob,
+        weight: r * index2_own / index2_k / prob,
         prob,
-        eta: index_k / index_own,
+        eta: (index2_k / index2_own).sqrt(),
         crossed: false,
     })
     .filter(|c| c.weight.is_finite())

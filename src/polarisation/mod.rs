@@ -27,6 +27,7 @@ mod biaxial_boundary;
 pub mod boundary;
 pub mod crystal;
 pub mod cvec;
+pub mod etendue;
 pub mod fresnel;
 pub mod interference;
 pub mod mueller;

@@ -6,7 +6,7 @@ use lapidary::render::{Control, World, render_scene};
 use lapidary::scene::Effect;
 
 /// Lossless biaxial spheres in a white unpolarised furnace read 1 like the calcite sphere, within
-/// noise and the same 1 % bound on the radiance scaling: iolite (n 1.542, 1.548, 1.551) and a
+/// 5 standard errors and the same 0.1 % for trapped light: iolite (n 1.542, 1.548, 1.551) and a
 /// strongly biaxial crystal (1.5, 1.65, 1.72) with its axes turned off the view, whose paths
 /// cross the optic axes and meet total internal reflection of either wave.
 #[test]
@@ -21,7 +21,7 @@ fn biaxial_spheres_in_a_white_furnace() {
         ));
         eprintln!("biaxial sphere {ior}/{beta}/{gamma}: {got:.5} ± {se:.5}");
         assert!(
-            (got - 1.0).abs() < 0.01 + 5.0 * se,
+            (got - 1.0).abs() < 1e-3 + 5.0 * se,
             "{ior}/{beta}/{gamma}: {got} ± {se}"
         );
     }
