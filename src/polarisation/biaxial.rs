@@ -16,7 +16,7 @@
 //! ([`super::quartic`]). The ray — the direction energy travels — is the index surface's normal
 //! `∇F`, equal to the Poynting vector `E × (k × E)`.
 
-use super::cvec::{CVec, cross as ccross, cv as complex, dot as cdot, norm as cnorm};
+use super::cvec::{CVec, cross as ccross, cv as complex, dot as cdot, norm as cnorm, real};
 use super::quartic;
 use glam::DVec3;
 use num_complex::Complex64 as C;
@@ -136,6 +136,11 @@ impl Biaxial {
     /// vector of `M`, the largest cross product of two of its rows; where `M` has rank one (the
     /// two waves coincide: along an optic axis) the first of [`Biaxial::degenerate_fields`].
     pub fn field(&self, k: CVec, reference: DVec3, second: bool) -> CVec {
+        if k.iter().all(|c| c.im == 0.0)
+            && let Some(e) = self.real_field(real(k))
+        {
+            return complex(e);
+        }
         let rows = self.rows(k);
         let scale = self.n.iter().fold(0.0f64, |m, v| m.max(v * v)).powi(2);
         let mut best = ccross(rows[0], rows[1]);
@@ -150,6 +155,43 @@ impl Biaxial {
         } else {
             self.degenerate_fields(k, reference)[usize::from(second)]
         }
+    }
+
+    /// [`Biaxial::field`] of a propagating wave (real `k`) in real arithmetic: the complex path's
+    /// operations on numbers whose imaginary parts are zero, so the same field bit for bit
+    /// (tested). `None` where the rows have rank one (the complex path's degenerate fields).
+    fn real_field(&self, k: DVec3) -> Option<DVec3> {
+        let e = self.eps();
+        let k = k.to_array();
+        let kk = k[0] * k[0] + k[1] * k[1] + k[2] * k[2];
+        let rows: [[f64; 3]; 3] = std::array::from_fn(|j| {
+            let mut r = [k[j] * k[0], k[j] * k[1], k[j] * k[2]];
+            r[j] -= kk;
+            for (i, a) in self.axes.iter().enumerate() {
+                let (aj, al) = (a.to_array()[j], a.to_array());
+                for (l, v) in r.iter_mut().enumerate() {
+                    *v += e[i] * aj * al[l];
+                }
+            }
+            r
+        });
+        let cross = |a: [f64; 3], b: [f64; 3]| {
+            [
+                a[1] * b[2] - a[2] * b[1],
+                a[2] * b[0] - a[0] * b[2],
+                a[0] * b[1] - a[1] * b[0],
+            ]
+        };
+        let norm = |a: [f64; 3]| (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+        let scale = self.n.iter().fold(0.0f64, |m, v| m.max(v * v)).powi(2);
+        let mut best = cross(rows[0], rows[1]);
+        for cand in [cross(rows[1], rows[2]), cross(rows[2], rows[0])] {
+            if norm(cand) > norm(best) {
+                best = cand;
+            }
+        }
+        let nb = norm(best);
+        (nb > 1e-7 * scale).then(|| DVec3::from_array(best.map(|c| c / nb)))
     }
 
     /// Two orthogonal fields of a wave along an optic axis, where every field across `M`'s one
@@ -215,8 +257,9 @@ impl Biaxial {
             a[1] / c4,
         ];
         // Start from each sheet's index along the wave an isotropic medium of index n_β would
-        // carry, up and down (imaginary when evanescent), tilted off the real axis so that no
-        // two starts coincide: within about Δn × walk-off of the roots.
+        // carry, up and down (imaginary when evanescent): within about Δn × walk-off of the
+        // roots. Durand–Kerner's starts (where the factor does not settle: near grazing, where
+        // up and down waves meet) are tilted off the real axis so that no two coincide.
         let q = |n: f64| C::from(n * n - tt).sqrt();
         let qb = q(self.n[1]).re;
         let guess = |up: bool| -> [C; 2] {
@@ -229,6 +272,19 @@ impl Biaxial {
             [sign * q(sheets[0]), sign * q(sheets[1])]
         };
         let ([uf, us], [df, ds]) = (guess(true), guess(false));
+        // A real quadratic factor to start Bairstow's method from: the two up waves when both
+        // propagate, else an evanescent sheet's decaying and growing pair (conjugates).
+        let pair = |a: C, b: C| (-(a + b).re, (a * b).re);
+        let (r, s) = if uf.im == 0.0 && us.im == 0.0 {
+            pair(uf, us)
+        } else if uf.im != 0.0 {
+            pair(uf, df)
+        } else {
+            pair(us, ds)
+        };
+        if let Some(u) = quartic::factored(c, r, s) {
+            return Some(u);
+        }
         let start = [
             uf * C::new(1.0, 1e-3),
             df * C::new(1.0, 2e-3),
@@ -395,6 +451,29 @@ pub(super) mod tests {
 
     /// The boundary quartic's real roots are waves on the index surface with the given
     /// tangential component.
+    /// A propagating wave's field in real arithmetic is the complex path's bit for bit.
+    #[test]
+    fn the_real_field_is_the_complex_one() {
+        let mut rng = Rng::new(8);
+        for _ in 0..2000 {
+            let b = Biaxial {
+                n: STRONG,
+                axes: random_axes(&mut rng),
+            };
+            let s = random_unit(&mut rng);
+            let reference = random_unit(&mut rng);
+            for (sheet, second) in [(0, false), (1, true)] {
+                let k = complex(b.indices(s)[sheet] * s);
+                let fast = b.field(k, reference, second);
+                // An imaginary part that is zero but not exactly takes the complex path.
+                let mut tiny = k;
+                tiny[0].im = 1e-300;
+                let slow = b.field(tiny, reference, second);
+                assert_eq!(fast.map(|c| c.re.to_bits()), slow.map(|c| c.re.to_bits()));
+            }
+        }
+    }
+
     #[test]
     fn boundary_roots_lie_on_the_index_surface() {
         let mut rng = Rng::new(4);
