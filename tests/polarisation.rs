@@ -24,6 +24,10 @@ use lapidary::scene::{Accuracy, Effect, Scene};
 #[path = "polarisation/biaxial.rs"]
 mod biaxial;
 
+/// Bare conductors: Fresnel's Mueller matrix for a complex index.
+#[path = "polarisation/conductor.rs"]
+mod conductor;
+
 /// Energy balance across a crystal's boundary: the radiance invariant.
 #[path = "polarisation/etendue.rs"]
 mod etendue;

@@ -170,6 +170,55 @@ fn the_stokes_vector_predicts_every_analyser() {
     assert!(checked > 100, "{checked}");
 }
 
+/// The same with the light sampled off a rough bare conductor (a polarising vertex in next-event
+/// estimation as well as in BSDF sampling): the Stokes rows read each light sample by their own
+/// Fresnel correction, and a polarising lamp's light after it.
+#[test]
+fn the_stokes_vector_predicts_every_analyser_off_a_rough_conductor() {
+    for polariser in ["", ", polariser: 30.0"] {
+        stokes_off_a_conductor(polariser);
+    }
+}
+
+fn stokes_off_a_conductor(polariser: &str) {
+    let slab = |analyser: Option<f32>| {
+        let a = analyser.map_or(String::new(), |a| format!("analyser: {a},"));
+        compile(&format!(
+            r#"(materials: {{ "metal": (base: Conductor(metal: Complex(n: (1.5, 0.4, 0.4),
+                                                                  k: (0.5, 2.0, 2.0)),
+                                                     roughness: 8.0)) }},
+                surface: Material("metal"),
+                stage: (shape: Slab(size: (40.0, 1.0, 40.0)),
+                        transform: (translate: (0.0, -0.5, 0.0)), ground: Off,
+                        environment: Constant(Gray(0.1)),
+                        lights: [Rect(center: (0.0, 3.0, -4.0), target: (0.0, 0.0, 0.0),
+                                      size: (3.0, 3.0), radiance: Gray(4.0) {polariser})],
+                        camera: Orthographic(from: (1.0, 3.2, 3.8), to: (0.0, 0.0, 0.0),
+                                             height: 0.5),
+                        {a}
+                        render: (width: 16, height: 16, spp: 8, max_depth: 3, seed: 5)))"#
+        ))
+    };
+    let st = stokes0(&film(&with_stokes(&slab(None)), None));
+    // Reflection off the conductor polarises: S1 is a large share of S0.
+    let (s0, s1) = st
+        .iter()
+        .fold((0.0, 0.0), |a, p| (a.0 + p[0], a.1 + p[1].abs()));
+    assert!(s1 > 0.2 * s0, "S0 {s0} |S1| {s1}");
+    for alpha in [0.0f32, 45.0, 90.0, 150.0] {
+        let f = film(&slab(Some(alpha)), None);
+        let a = 2.0 * f64::from(alpha).to_radians();
+        for (px, p) in st.iter().zip(&f.pixels) {
+            let want = 0.5 * (px[0] + px[1] * a.cos() + px[2] * a.sin());
+            let got = f64::from(p.mean()[0]);
+            assert!(
+                (got - want).abs() <= 1e-5 * (1.0 + want.abs()),
+                "analyser {alpha}°: {got} vs ½(S0 + S1 cos 2α + S2 sin 2α) = {want}"
+            );
+        }
+    }
+}
+
 #[test]
 fn s0_is_the_colour_and_the_aovs_do_not_depend_on_threads() {
     // A glass sphere in a sky and the dichroic sunstone (a crystal's boundary in the paths).

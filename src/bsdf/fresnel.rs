@@ -191,6 +191,17 @@ pub enum Fresnel {
 }
 
 impl Fresnel {
+    /// The relative complex IOR `n + i k` of channel `c` of a conductor whose form keeps it (the
+    /// exact equations and Lazányi–Szirmay-Kalos); `None` for a dielectric, the perfect mirror,
+    /// Schlick's `R₀` and a table, which keep only reflectances. Polarised transport reads it
+    /// (Fresnel's Mueller matrix needs the amplitudes).
+    pub fn complex_ior(&self, c: usize) -> Option<(f32, f32)> {
+        match self {
+            Fresnel::Conductor { n, k } | Fresnel::Lazanyi { n, k } => Some((n[c], k[c])),
+            _ => None,
+        }
+    }
+
     /// A dielectric interface with the given relative IOR, evaluated in `mode`.
     pub fn dielectric(eta: f32, mode: FresnelMode) -> Self {
         let exact = Fresnel::Dielectric { eta };

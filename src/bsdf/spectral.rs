@@ -61,6 +61,16 @@ pub trait Scatter<S: Spectral> {
     /// (what polarised transport turns into Fresnel's Mueller matrices,
     /// [`crate::polarisation::transport`]).
     fn interface_eta(&self, channel: usize, lambda: &S::Wavelengths) -> Option<f32>;
+
+    /// The relative complex IOR `(n, k)` at the wavelength of `channel` of a bare conductor — a
+    /// Torrance–Sparrow conductor lobe, or a stack without coats over one — whose Fresnel form
+    /// keeps it ([`super::Fresnel::complex_ior`]; spectral paths: a measured metal's tables);
+    /// `None` for any other model. Polarised transport reflects off it by Fresnel's Mueller
+    /// matrix instead of depolarising. By default none (a transport without conductor indices
+    /// per channel leaves conductors depolarising).
+    fn conductor_ior(&self, _channel: usize, _lambda: &S::Wavelengths) -> Option<(f32, f32)> {
+        None
+    }
 }
 
 impl Scatter<RgbSample> for Bsdf {
@@ -87,6 +97,15 @@ impl Scatter<RgbSample> for Bsdf {
     fn interface_eta(&self, _channel: usize, _: &RgbWavelengths) -> Option<f32> {
         match self {
             Bsdf::SmoothDielectric(b) => Some(b.eta),
+            _ => None,
+        }
+    }
+    fn conductor_ior(&self, channel: usize, _: &RgbWavelengths) -> Option<(f32, f32)> {
+        match self {
+            Bsdf::TorranceSparrow(b) => b.fresnel.complex_ior(channel),
+            Bsdf::Layered(l) if l.levels.is_empty() => {
+                <Bsdf as Scatter<RgbSample>>::conductor_ior(&l.base, channel, &RgbWavelengths)
+            }
             _ => None,
         }
     }
@@ -224,6 +243,21 @@ impl Scatter<HeroSample> for Bsdf {
                 None => b.eta,
                 Some(law) => law.eta_at(lambda.lambda[channel]),
             }),
+            _ => None,
+        }
+    }
+    fn conductor_ior(&self, channel: usize, lambda: &HeroWavelengths) -> Option<(f32, f32)> {
+        match self {
+            _ if !(lambda.pdf[channel] > 0.0) => None,
+            // A measured metal's `n + i k` at the wavelength, relative to its host, as
+            // `facet_fresnel` evaluates it; an RGB `n, k` has none per wavelength.
+            Bsdf::TorranceSparrow(b) => b.metal.map(|m| {
+                let (n, k) = m.metal.nk_at(lambda.lambda[channel]);
+                (n / m.host, k / m.host)
+            }),
+            Bsdf::Layered(l) if l.levels.is_empty() => {
+                <Bsdf as Scatter<HeroSample>>::conductor_ior(&l.base, channel, lambda)
+            }
             _ => None,
         }
     }

@@ -97,6 +97,28 @@ impl StokesRows {
         }
     }
 
+    /// What each row reads of light reaching the path through `event` (a light sample off a
+    /// polarising vertex), times its factor, as [`StokesRows::polarised_emission`] gives it:
+    /// per row and channel the event's correction `((1, w)·N)₀`, and for a light behind a
+    /// polariser (`(axis, d)`: its axis and the light's propagation, world, unit) the row's
+    /// reading of that polarisation after the event (the rows themselves unchanged). Rows that
+    /// have settled read as the sensor does (the caller's [`StokesRows::settled`] case).
+    pub fn read_light(
+        &self,
+        event: &InterfaceEvent,
+        polariser: Option<(Vec3, Vec3)>,
+    ) -> [[f32; MAX_CHANNELS]; ROWS] {
+        let t = turn(self.rows[0].x, event.s, event.wo);
+        std::array::from_fn(|j| {
+            let mut row = self.rows[j];
+            let k = row.take_turned(event, t);
+            let p = polariser.map_or([1.0; MAX_CHANNELS], |(axis, d)| {
+                row.polarised_emission(axis, d)
+            });
+            std::array::from_fn(|c| k[c] * p[c] * self.f[j][c])
+        })
+    }
+
     /// Multiplies row `j`'s factors by `k_row / k_sensor` per channel.
     #[inline]
     pub fn rescale(&mut self, j: usize, k_row: [f32; MAX_CHANNELS], k_sensor: [f32; MAX_CHANNELS]) {

@@ -264,11 +264,7 @@ impl InterfaceEvent {
         kind: Interface,
         x: Vec3,
     ) -> InterfaceEvent {
-        let s = n.cross(wo).try_normalize().unwrap_or_else(|| {
-            (x - wo * x.dot(wo))
-                .try_normalize()
-                .unwrap_or_else(|| wo.any_orthonormal_vector())
-        });
+        let s = s_axis(n, wo, x);
         let cos_i = f64::from(wi.dot(n).abs()).min(1.0);
         let m = eta.map(|e| {
             e.map(|e| match kind {
@@ -278,6 +274,46 @@ impl InterfaceEvent {
         });
         InterfaceEvent { s, wo, m }
     }
+}
+
+impl InterfaceEvent {
+    /// Reflection off a conductor's micro-facet with unit normal `h` (the half vector of `wo` and
+    /// `wi`; the surface normal for a mirror): the light leaves along `wo`, arrived from `wi`,
+    /// and `nk[c]` is the conductor's relative complex IOR per channel (`None`: a channel the
+    /// path no longer carries). The facet's plane of incidence sets the frame, as for a rough
+    /// conductor in Mitsuba 3's polarised variants (Jakob et al. 2022): a rough conductor is a
+    /// mixture of mirrors, each polarising by its own Fresnel matrix.
+    pub fn conductor(
+        h: Vec3,
+        wo: Vec3,
+        wi: Vec3,
+        nk: [Option<(f32, f32)>; MAX_CHANNELS],
+        x: Vec3,
+    ) -> InterfaceEvent {
+        let s = s_axis(h, wo, x);
+        let cos_i = f64::from(wi.dot(h).abs()).min(1.0);
+        let m = nk.map(|v| {
+            v.map(|(n, k)| {
+                Some(fresnel::conductor_reflection(
+                    cos_i,
+                    f64::from(n),
+                    f64::from(k),
+                ))
+            })
+        });
+        InterfaceEvent { s, wo, m }
+    }
+}
+
+/// The s axis of an event at normal `n` with the light leaving along `wo`: the normal of the
+/// plane of incidence, or a row's axis `x` (made across `wo`) at normal incidence, where every
+/// axis is one.
+fn s_axis(n: Vec3, wo: Vec3, x: Vec3) -> Vec3 {
+    n.cross(wo).try_normalize().unwrap_or_else(|| {
+        (x - wo * x.dot(wo))
+            .try_normalize()
+            .unwrap_or_else(|| wo.any_orthonormal_vector())
+    })
 }
 
 /// The intensity an ideal linear polariser passes of unpolarised light.

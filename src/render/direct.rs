@@ -4,10 +4,13 @@
 //! manifold walks against BSDF sampling of the same chains ([`super::manifold`]).
 
 use super::path::{PathSample, PathState};
+use super::polarised::{NeePolarisation, conductor_nee};
 use super::shading::SurfaceBsdf;
 use super::world::{LightRef, World};
 use crate::bsdf::{Bsdf, Scatter, power_heuristic};
 use crate::geometry::{Ray, offset_origin};
+use crate::polarisation::stokes::ROWS;
+use crate::polarisation::transport::MAX_CHANNELS;
 use crate::spectrum::Spectral;
 use glam::Vec3;
 
@@ -24,19 +27,28 @@ pub enum Strategy {
     BsdfOnly,
 }
 
+/// What the Stokes AOVs' rows read of a light sample at a polarising vertex: the contribution
+/// before any row's correction and each row's reading
+/// ([`super::polarised::StokesAov::add_read`]).
+pub(super) type RowsRead<S> = Option<(S, [[f32; MAX_CHANNELS]; ROWS])>;
+
 /// Next-event estimation at `sb`: one light sample, weighted against BSDF sampling by `strategy`.
-/// Returns what it added to the path's radiance (zero when nothing).
+/// Returns what it added to the path's radiance (zero when nothing). With `POL` (polarised
+/// transport), `polar` is the camera path's polarisation, which a bare conductor's Fresnel
+/// matrix changes the sample's contribution by, and `rows` receives what the Stokes AOVs' rows
+/// read of it there; without, both are untouched and the conductor's code is not compiled in.
 #[allow(clippy::too_many_arguments)]
-#[inline]
-pub(super) fn direct_light<S: Spectral>(
+#[inline(always)]
+pub(super) fn direct_light<S: Spectral, const POL: bool>(
     world: &World,
     strategy: Strategy,
     sb: &SurfaceBsdf,
     wo_local: Vec3,
-    u_light: f32,
-    u_point: glam::Vec2,
+    (u_light, u_point): (f32, glam::Vec2),
     path: &mut PathState<S>,
     out: &mut PathSample,
+    polar: Option<&NeePolarisation<'_>>,
+    rows: &mut RowsRead<S>,
 ) -> S
 where
     Bsdf: Scatter<S>,
@@ -78,11 +90,24 @@ where
         LightRef::Environment => S::from_illuminant(ls.radiance, &path.lambda),
     };
     let c = path.throughput() * f * radiance * (wi_local.z.abs() * w / p_light);
-    if c.is_valid() {
-        path.gather(c)
-    } else {
-        S::ZERO
+    if !c.is_valid() {
+        return S::ZERO;
     }
+    if POL
+        && let Some(p) = polar
+        && let Some(r) = {
+            let polariser = match light {
+                LightRef::Area(i) => world.areas[i].polariser(),
+                LightRef::Environment => None,
+            };
+            let dirs = (sb.frame.to_world(wo_local), ls.wi);
+            conductor_nee::<S>(p, sb, dirs, polariser, &path.lambda)
+        }
+    {
+        *rows = r.rows.map(|kf| (path.gathered(c), kf));
+        return path.gather(c * S::from_channels(|ch| r.k[ch]));
+    }
+    path.gather(c)
 }
 
 /// Weight of one of the two ways to a light through the boundary (module [`manifold`]):

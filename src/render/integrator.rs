@@ -68,8 +68,8 @@ use super::manifold;
 use super::manifold::{Chain, WalkNumbers, WalkVertex};
 use super::path::{ManifoldVertex, PathSample, PathState, keep_off_the_boundary};
 use super::polarised::{
-    StokesAov, crystal_boundary, crystal_sample, pleochroic_segment, pleochroic_transmittance,
-    polarise, stokes_add,
+    NeePolarisation, StokesAov, crystal_boundary, crystal_sample, pleochroic_segment,
+    pleochroic_transmittance, polarise, stokes_add,
 };
 use super::shading::shade;
 use super::world::{Hit, LightRef, World};
@@ -364,11 +364,30 @@ where
         let sees_out = path.medium == MediumId::OUTSIDE || sb.flags().is_transmission();
         let nee = strategy != Strategy::BsdfOnly && !sb.flags().is_specular_only() && sees_out;
         if nee {
-            let added = direct_light(
-                world, strategy, &sb, wo_local, u_light, u_point, &mut path, &mut out,
+            // Inside a crystal the path carries a wave, which a conductor's matrix would not
+            // keep: platelets there depolarise (docs/polarisation.md).
+            let in_crystal = world.crystal.is_some() && path.medium != MediumId::OUTSIDE;
+            let polar = (POL && !in_crystal).then(|| NeePolarisation {
+                pol: &pol,
+                rows: aov.as_ref().filter(|_| STOKES).map(|a| &a.rows),
+            });
+            let mut read = None;
+            let added = direct_light::<S, POL>(
+                world,
+                strategy,
+                &sb,
+                wo_local,
+                (u_light, u_point),
+                &mut path,
+                &mut out,
+                polar.as_ref(),
+                &mut read,
             );
             if STOKES {
-                stokes_add(&mut aov, added);
+                match (read, aov.as_mut()) {
+                    (Some((c, kf)), Some(a)) => a.add_read(c, kf),
+                    _ => stokes_add(&mut aov, added),
+                }
             }
         }
         // Manifold next-event estimation from a platelet (the light it sees through the
@@ -488,7 +507,9 @@ where
         path.scatter(&bs, sb.p, sb.inside);
         if POL && crystal.is_none() {
             let rows = aov.as_mut().filter(|_| STOKES).map(|a| &mut a.rows);
-            polarise(&mut pol, rows, &mut path, &sb, &bs, wo, wo_local.z > 0.0);
+            let in_crystal = world.crystal.is_some() && path.medium != MediumId::OUTSIDE;
+            let above = wo_local.z > 0.0;
+            polarise(&mut pol, rows, &mut path, &sb, &bs, wo, above, !in_crystal);
         }
         path.platelet = match hit {
             Hit::Platelet { id, .. } => Some(id),

@@ -80,12 +80,15 @@ pub(super) fn stokes_add<S: Spectral>(aov: &mut Option<StokesAov<S>>, added: S) 
 }
 
 /// The Stokes row's update at a BSDF-sampled vertex: Fresnel's Mueller matrix at a smooth
-/// dielectric interface (the throughput corrected per channel), depolarisation anywhere else;
-/// the Stokes AOVs' rows alike.
+/// dielectric interface and at a bare conductor's facet (the throughput corrected per channel),
+/// depolarisation anywhere else; the Stokes AOVs' rows alike.
 ///
 /// # Arguments
 /// * `wo` – the direction the light leaves toward the previous vertex (world, unit).
 /// * `above` – whether `wo` lies above the interface's frame (`z > 0`).
+/// * `conductors` – whether a bare conductor polarises here (not inside a crystal, where the
+///   path carries one of the crystal's waves).
+#[allow(clippy::too_many_arguments)]
 #[inline]
 pub(super) fn polarise<S: Spectral>(
     pol: &mut PathPolarisation,
@@ -95,10 +98,31 @@ pub(super) fn polarise<S: Spectral>(
     bs: &BsdfSample<S>,
     wo: Vec3,
     above: bool,
+    conductors: bool,
 ) where
     Bsdf: Scatter<S>,
 {
     use crate::polarisation::transport::Interface;
+    if conductors
+        && !bs.flags.is_transmission()
+        && let Some(nk) = conductor_nk::<S>(sb, &path.lambda)
+    {
+        // A bare conductor: its facet's Fresnel matrix (the half vector of the two directions).
+        let Some(h) = (wo + bs.wi).try_normalize() else {
+            pol.depolarise();
+            if let Some(r) = rows {
+                r.depolarise();
+            }
+            return;
+        };
+        let event = InterfaceEvent::conductor(h, wo, bs.wi, nk, pol.x);
+        let k = pol.take(&event);
+        if let Some(r) = rows {
+            r.take(&event, k);
+        }
+        path.beta *= S::from_channels(|c| k[c]);
+        return;
+    }
     if !bs.flags.is_specular() || sb.interface_eta::<S>(0, &path.lambda).is_none() {
         pol.depolarise();
         if let Some(r) = rows {
@@ -127,6 +151,75 @@ pub(super) fn polarise<S: Spectral>(
         r.take(&event, k);
     }
     path.beta *= S::from_channels(|c| k[c]);
+}
+
+/// A bare conductor's relative complex IOR per channel (`None` for a channel the path no longer
+/// carries), or `None` if `sb` is no bare conductor ([`SurfaceBsdf::conductor_ior`]).
+fn conductor_nk<S: Spectral>(
+    sb: &SurfaceBsdf<'_>,
+    lambda: &S::Wavelengths,
+) -> Option<[Option<(f32, f32)>; MAX_CHANNELS]>
+where
+    Bsdf: Scatter<S>,
+{
+    sb.conductor_ior::<S>(0, lambda)?;
+    Some(std::array::from_fn(|c| {
+        (c < S::CHANNELS)
+            .then(|| sb.conductor_ior::<S>(c, lambda))
+            .flatten()
+    }))
+}
+
+/// The camera path's polarisation at a vertex where a light is sampled: its row and, with the
+/// Stokes AOVs, theirs.
+pub(super) struct NeePolarisation<'a> {
+    /// The sensor's row.
+    pub pol: &'a PathPolarisation,
+    /// The Stokes AOVs' rows.
+    pub rows: Option<&'a StokesRows>,
+}
+
+/// How a polarising vertex changes a light sample's contribution: the sensor row's correction
+/// per channel and, with the Stokes AOVs, each row's reading times its factor.
+pub(super) struct NeeRead {
+    /// Multiplies the contribution, per channel.
+    pub k: [f32; MAX_CHANNELS],
+    /// Per row and channel: what the row reads of the uncorrected contribution.
+    pub rows: Option<[[f32; MAX_CHANNELS]; ROWS]>,
+}
+
+/// A light sample (light arriving from the unit `wi`, leaving toward the camera along the unit
+/// `wo`, both world) off a bare conductor at `sb`: its Fresnel matrix read by the rows, and the
+/// light's own polarisation when it shines through a `polariser` (axis, world, unit); `None`
+/// when `sb` is no bare conductor (the contribution stays the scalar code's).
+pub(super) fn conductor_nee<S: Spectral>(
+    polar: &NeePolarisation<'_>,
+    sb: &SurfaceBsdf<'_>,
+    (wo, wi): (Vec3, Vec3),
+    polariser: Option<Vec3>,
+    lambda: &S::Wavelengths,
+) -> Option<NeeRead>
+where
+    Bsdf: Scatter<S>,
+{
+    let nk = conductor_nk::<S>(sb, lambda)?;
+    let h = (wo + wi).try_normalize()?;
+    let event = InterfaceEvent::conductor(h, wo, wi, nk, polar.pol.x);
+    let mut row = *polar.pol;
+    let mut k = row.take(&event);
+    if let Some(axis) = polariser {
+        // The row, now about the light's segment, reads the light's linear polarisation.
+        let p = row.polarised_emission(axis, -wi);
+        k = std::array::from_fn(|c| k[c] * p[c]);
+    }
+    Some(NeeRead {
+        k,
+        // Settled rows follow the sensor's row: they read the contribution as corrected.
+        rows: polar
+            .rows
+            .filter(|r| !r.settled)
+            .map(|r| r.read_light(&event, polariser.map(|a| (a, -wi)))),
+    })
 }
 
 /// The BSDF sample of a camera path meeting a doubly refractive body's smooth boundary

@@ -126,6 +126,23 @@ impl<'a> SurfaceBsdf<'a> {
         <Bsdf as Scatter<S>>::interface_eta(self.bxdf, channel, lambda)
     }
 
+    /// A bare conductor's relative complex IOR at the wavelength of `channel`
+    /// ([`Scatter::conductor_ior`]); `None` for any other model.
+    #[inline]
+    pub fn conductor_ior<S: Spectral>(
+        &self,
+        channel: usize,
+        lambda: &S::Wavelengths,
+    ) -> Option<(f32, f32)>
+    where
+        Bsdf: Scatter<S>,
+    {
+        if self.fluorescent.is_some() {
+            return None;
+        }
+        <Bsdf as Scatter<S>>::conductor_ior(self.bxdf, channel, lambda)
+    }
+
     /// Density of `wi_local` (local frame) from `wo_local`.
     #[inline]
     pub fn pdf<S: Spectral>(&self, wo_local: Vec3, wi_local: Vec3, lambda: &S::Wavelengths) -> f32

@@ -184,13 +184,15 @@ fn light_prefilter_runs_only_for_rgb_renders_under_spectral_lights() {
 #[test]
 fn polarisation_code_changes_nothing_without_a_smooth_boundary_or_polariser() {
     // Polarised transport forced on: every vertex of these scenes depolarises (Lambert, layered
-    // stacks, metals, a rough body boundary and its scattering medium), so the Stokes row stays
-    // zero and every throughput correction is exactly 1.
+    // stacks — a varnished metal among them —, a rough body boundary and its scattering medium),
+    // so the Stokes row stays zero and every throughput correction is exactly 1. (A bare metal
+    // polarises: `tests/polarisation/conductor.rs`.)
     let rough_body = scene(
         r#"(materials: {
                "body": (coats: [(ior: 1.5, roughness: 2.0, thickness: 1.0, tint: Rgb(0.9, 0.6, 0.8))],
                         base: Lambert(albedo: Gray(0.6))),
-               "glitter": (base: Conductor(metal: Silver, roughness: 2.0)) },
+               "glitter": (coats: [(ior: 1.5, roughness: 1.0)],
+                           base: Conductor(metal: Silver, roughness: 2.0)) },
             body: (ior: 1.55, roughness: 3.0,
                    medium: (colour: Srgb(0.9, 0.7, 0.6), distance: 1.0, scattering: (2.0, 2.0, 2.0))),
             surface: Overlay(
