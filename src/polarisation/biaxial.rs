@@ -164,7 +164,7 @@ impl Biaxial {
         let e = self.eps();
         let k = k.to_array();
         let kk = k[0] * k[0] + k[1] * k[1] + k[2] * k[2];
-        let rows: [[f64; 3]; 3] = std::array::from_fn(|j| {
+        let rows: [DVec3; 3] = std::array::from_fn(|j| {
             let mut r = [k[j] * k[0], k[j] * k[1], k[j] * k[2]];
             r[j] -= kk;
             for (i, a) in self.axes.iter().enumerate() {
@@ -173,25 +173,18 @@ impl Biaxial {
                     *v += e[i] * aj * al[l];
                 }
             }
-            r
+            DVec3::from_array(r)
         });
-        let cross = |a: [f64; 3], b: [f64; 3]| {
-            [
-                a[1] * b[2] - a[2] * b[1],
-                a[2] * b[0] - a[0] * b[2],
-                a[0] * b[1] - a[1] * b[0],
-            ]
-        };
-        let norm = |a: [f64; 3]| (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+        // glam's cross and length form the same products and sums as the complex path's.
         let scale = self.n.iter().fold(0.0f64, |m, v| m.max(v * v)).powi(2);
-        let mut best = cross(rows[0], rows[1]);
-        for cand in [cross(rows[1], rows[2]), cross(rows[2], rows[0])] {
-            if norm(cand) > norm(best) {
+        let mut best = rows[0].cross(rows[1]);
+        for cand in [rows[1].cross(rows[2]), rows[2].cross(rows[0])] {
+            if cand.length() > best.length() {
                 best = cand;
             }
         }
-        let nb = norm(best);
-        (nb > 1e-7 * scale).then(|| DVec3::from_array(best.map(|c| c / nb)))
+        let nb = best.length();
+        (nb > 1e-7 * scale).then(|| best / nb)
     }
 
     /// Two orthogonal fields of a wave along an optic axis, where every field across `M`'s one
@@ -449,8 +442,6 @@ pub(super) mod tests {
         assert!(same as f64 > 0.97 * tried as f64, "{same} of {tried}");
     }
 
-    /// The boundary quartic's real roots are waves on the index surface with the given
-    /// tangential component.
     /// A propagating wave's field in real arithmetic is the complex path's bit for bit.
     #[test]
     fn the_real_field_is_the_complex_one() {
@@ -474,6 +465,8 @@ pub(super) mod tests {
         }
     }
 
+    /// The boundary quartic's real roots are waves on the index surface with the given
+    /// tangential component.
     #[test]
     fn boundary_roots_lie_on_the_index_surface() {
         let mut rng = Rng::new(4);
