@@ -16,6 +16,12 @@ them with its camera analyser at 0°, 90°, 45° and 135° from the image's righ
 (`I(θ) = ½ (S0 + S1 cos 2θ + S2 sin 2θ)`, so `S0 = I(0) + I(90)`, `S1 = I(0) − I(90)`,
 `S2 = I(45) − I(135)`), spectral and polarised.
 
+`--scene conductor`: the sphere is instead a rough conductor (Beckmann α 0.2, Smith's separable
+masking, index 1.5 + 0.5i at every wavelength — a weak absorber whose s and p reflectances part
+widely; lapidary's RGB transport with that index in every channel, Mitsuba's spectral one with
+it constant) in a white constant sky: every micro-facet polarises by its own Fresnel matrix, in
+BSDF sampling and in light sampling of the sky.
+
 Printed: over the pixels on the sphere, per quadrant of the image (where S2 lives: the pattern
 turns with the azimuth) and per wedge about the horizontal and the vertical (where S1 lives), the means of S0 and of S1/S0 and S2/S0 weighted by S0 from both renderers, with
 lapidary's standard error from its variance channels. Outputs (EXRs) go to OUT_DIR (default
@@ -50,10 +56,39 @@ RECIPE = """(
 """
 
 
-def mitsuba(size, spp, out):
+CONDUCTOR = """(
+    materials: {{ "metal": (base: Conductor(metal: Complex(n: (1.5, 1.5, 1.5), k: (0.5, 0.5, 0.5)),
+                                           alpha: 0.2),
+                           distribution: Beckmann, masking: SmithSeparable, compensation: false) }},
+    surface: Material("metal"),
+    stage: (
+        shape: Sphere(radius: 1.0),
+        ground: Off,
+        environment: Constant(Gray(1.0)),
+        lights: [],
+        camera: Perspective(from: (0.0, 0.0, 4.0), to: (0.0, 0.0, 0.0), fov: 30.0),
+        analyser: {analyser},
+        render: (width: {size}, height: {size}, spp: {spp}, max_depth: 16, filter: Box,
+                 sampler: Independent),
+    ),
+)
+"""
+
+
+def mitsuba(size, spp, out, scene_kind="sphere"):
     import mitsuba as mi
     mi.set_variant("scalar_spectral_polarized")
     T = mi.ScalarTransform4f
+    sphere_scene = {
+        "sphere": {"type": "sphere", "radius": 1.0,
+                   "bsdf": {"type": "dielectric", "int_ior": 1.5, "ext_ior": 1.0}},
+        # Mitsuba's rectangle is [-1, 1]² in z = 0, emitting toward +z; look_at turns +z to the
+        # target.
+        "light": {"type": "rectangle",
+                  "to_world": T().look_at(origin=[0, 0, -3], target=[0, 0, 0], up=[0, 1, 0])
+                  @ T().scale([3.0, 3.0, 1.0]),
+                  "emitter": {"type": "area", "radiance": {"type": "rgb", "value": [1, 1, 1]}}},
+    }
     scene = mi.load_dict({
         "type": "scene",
         "integrator": {"type": "stokes", "integrator": {"type": "path", "max_depth": 16}},
@@ -64,30 +99,34 @@ def mitsuba(size, spp, out):
                      "rfilter": {"type": "box"}},
             "sampler": {"type": "independent", "sample_count": spp},
         },
-        "sphere": {"type": "sphere", "radius": 1.0,
-                   "bsdf": {"type": "dielectric", "int_ior": 1.5, "ext_ior": 1.0}},
-        # Mitsuba's rectangle is [-1, 1]² in z = 0, emitting toward +z; look_at turns +z to the
-        # target.
-        "light": {"type": "rectangle",
-                  "to_world": T().look_at(origin=[0, 0, -3], target=[0, 0, 0], up=[0, 1, 0])
-                  @ T().scale([3.0, 3.0, 1.0]),
-                  "emitter": {"type": "area", "radiance": {"type": "rgb", "value": [1, 1, 1]}}},
+        **(CONDUCTOR_SCENE if scene_kind == "conductor" else sphere_scene),
     })
     # The stokes integrator's channels: the colour (3), then S0, S1, S2, S3 × (R, G, B)
     # (`aov_names()`).
     return np.array(mi.render(scene))
 
 
-def lapidary(size, spp, out):
+CONDUCTOR_SCENE = {
+    "sphere": {"type": "sphere", "radius": 1.0,
+               "bsdf": {"type": "roughconductor", "distribution": "beckmann", "alpha": 0.2,
+                        "eta": 1.5, "k": 0.5}},
+    "sky": {"type": "constant", "radiance": {"type": "rgb", "value": [1, 1, 1]}},
+}
+
+
+def lapidary(size, spp, out, scene_kind="sphere"):
     bin_ = ROOT / "target" / "release" / "lapidary"
     import mitsuba as mi
     imgs = {}
     for a in (0, 90, 45, 135):
         recipe = out / f"sphere-{a}.ron"
-        recipe.write_text(RECIPE.format(analyser=float(a), size=size, spp=spp))
+        text = CONDUCTOR if scene_kind == "conductor" else RECIPE
+        recipe.write_text(text.format(analyser=float(a), size=size, spp=spp))
         exr = out / f"lapidary-{a}.exr"
+        # The conductor's index is an RGB one: its polarisation runs on RGB paths.
+        transport = ["--spectral", "off"] if scene_kind == "conductor" else ["--spectral"]
         subprocess.run([str(bin_), "render", str(recipe), "-o", str(exr), "--no-png",
-                        "--spectral", "--quiet"], check=True)
+                        *transport, "--quiet"], check=True)
         bmp = mi.Bitmap(str(exr))
         names = [f.name for f in bmp.struct_()]
         arr = np.array(bmp)
@@ -103,15 +142,16 @@ def main():
     ap.add_argument("out", nargs="?", default=str(ROOT / "target" / "mitsuba-polarised"))
     ap.add_argument("--spp", type=int, default=256)
     ap.add_argument("--size", type=int, default=96)
+    ap.add_argument("--scene", choices=("sphere", "conductor"), default="sphere")
     a = ap.parse_args()
-    out = Path(a.out)
+    out = Path(a.out) / a.scene
     out.mkdir(parents=True, exist_ok=True)
-    arr = mitsuba(a.size, a.spp, out)
+    arr = mitsuba(a.size, a.spp, out, a.scene)
     nch = arr.shape[2]
     # Channels: the path integrator's RGB(A?) then S0..S3 × RGB; the last 12 are the Stokes.
     stokes = arr[..., nch - 12:].reshape(a.size, a.size, 4, 3).mean(axis=3)
     m = {k: stokes[..., i] for i, k in enumerate(("S0", "S1", "S2", "S3"))}
-    imgs = lapidary(a.size, a.spp, out)
+    imgs = lapidary(a.size, a.spp, out, a.scene)
     l = {"S0": imgs[0][0] + imgs[90][0], "S1": imgs[0][0] - imgs[90][0],
          "S2": imgs[45][0] - imgs[135][0]}
     var = {"S0": imgs[0][1] + imgs[90][1], "S1": imgs[0][1] + imgs[90][1],
