@@ -331,6 +331,7 @@ impl Boundary {
 #[cfg(test)]
 pub(super) mod tests {
     use super::*;
+    use crate::polarisation::biaxial::tests::random_unit;
     use crate::polarisation::fresnel;
     use crate::polarisation::uniaxial::Uniaxial;
     use crate::sampler::Rng;
@@ -371,13 +372,6 @@ pub(super) mod tests {
             }
         }
         checked
-    }
-
-    fn random_unit(rng: &mut Rng) -> DVec3 {
-        let z = 2.0 * f64::from(rng.uniform()) - 1.0;
-        let phi = std::f64::consts::TAU * f64::from(rng.uniform());
-        let r = (1.0 - z * z).sqrt();
-        DVec3::new(r * phi.cos(), r * phi.sin(), z)
     }
 
     fn boundary(no: f64, ne: f64, axis: DVec3) -> Boundary {
