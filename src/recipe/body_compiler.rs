@@ -189,7 +189,7 @@ impl Compiler<'_> {
         Some(body)
     }
 
-    /// Turns on manifold next-event estimation (issue 18) where it can help: a body the surface
+    /// Turns on manifold next-event estimation (docs/platelets.md) where it can help: a body the surface
     /// shows, with a smooth boundary (the walk solves Snell's law at a specular interface), under
     /// at least one emitting area light (the walk connects to points on lights) — from inside
     /// (`manifold-nee`) where the body holds platelets or a scattering medium (vertices inside

@@ -3,8 +3,8 @@
 //! SIGGRAPH 1995: power heuristic, β = 2): next-event estimation against BSDF sampling, and the
 //! manifold walks against BSDF sampling of the same chains ([`super::manifold`]).
 
+use super::metal::{NeePolarisation, conductor_nee};
 use super::path::{PathSample, PathState};
-use super::polarised::{NeePolarisation, conductor_nee};
 use super::shading::SurfaceBsdf;
 use super::world::{LightRef, World};
 use crate::bsdf::{Bsdf, Scatter, power_heuristic};

@@ -66,10 +66,11 @@ use super::direct::{
 };
 use super::manifold;
 use super::manifold::{Chain, WalkNumbers, WalkVertex};
+use super::metal::NeePolarisation;
 use super::path::{ManifoldVertex, PathSample, PathState, keep_off_the_boundary};
 use super::polarised::{
-    NeePolarisation, StokesAov, crystal_boundary, crystal_sample, pleochroic_segment,
-    pleochroic_transmittance, polarise, stokes_add,
+    StokesAov, crystal_boundary, crystal_sample, pleochroic_segment, pleochroic_transmittance,
+    polarise, stokes_add,
 };
 use super::shading::shade;
 use super::world::{Hit, LightRef, World};
@@ -363,10 +364,11 @@ where
         // Inside the stone only a transmitting boundary can see a light (module docs).
         let sees_out = path.medium == MediumId::OUTSIDE || sb.flags().is_transmission();
         let nee = strategy != Strategy::BsdfOnly && !sb.flags().is_specular_only() && sees_out;
+        // Inside a crystal the path carries a wave, which a conductor's matrix would not keep:
+        // platelets there depolarise (docs/polarisation.md). (A conductor only reflects, so the
+        // medium is the same after the vertex's scattering.)
+        let in_crystal = POL && world.crystal.is_some() && path.medium != MediumId::OUTSIDE;
         if nee {
-            // Inside a crystal the path carries a wave, which a conductor's matrix would not
-            // keep: platelets there depolarise (docs/polarisation.md).
-            let in_crystal = world.crystal.is_some() && path.medium != MediumId::OUTSIDE;
             let polar = (POL && !in_crystal).then(|| NeePolarisation {
                 pol: &pol,
                 rows: aov.as_ref().filter(|_| STOKES).map(|a| &a.rows),
@@ -507,7 +509,6 @@ where
         path.scatter(&bs, sb.p, sb.inside);
         if POL && crystal.is_none() {
             let rows = aov.as_mut().filter(|_| STOKES).map(|a| &mut a.rows);
-            let in_crystal = world.crystal.is_some() && path.medium != MediumId::OUTSIDE;
             let above = wo_local.z > 0.0;
             polarise(&mut pol, rows, &mut path, &sb, &bs, wo, above, !in_crystal);
         }

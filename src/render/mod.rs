@@ -24,6 +24,7 @@ pub mod integrator;
 pub mod lanes;
 pub mod manifold;
 pub mod memory;
+mod metal;
 pub mod output;
 pub mod part;
 pub mod path;
