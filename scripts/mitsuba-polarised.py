@@ -22,6 +22,11 @@ widely; lapidary's RGB transport with that index in every channel, Mitsuba's spe
 it constant) in a white constant sky: every micro-facet polarises by its own Fresnel matrix, in
 BSDF sampling and in light sampling of the sky.
 
+`--scene rough-glass`: the glass sphere's boundary is instead rough (Beckmann α 0.2, Smith's
+separable masking, no energy compensation — Mitsuba's `roughdielectric`): every micro-facet
+reflects and refracts by its own Fresnel matrices, in BSDF sampling and in light sampling
+(from inside, through the boundary).
+
 Printed: over the pixels on the sphere, per quadrant of the image (where S2 lives: the pattern
 turns with the azimuth) and per wedge about the horizontal and the vertical (where S1 lives), the means of S0 and of S1/S0 and S2/S0 weighted by S0 from both renderers, with
 lapidary's standard error from its variance channels. Outputs (EXRs) go to OUT_DIR (default
@@ -54,6 +59,12 @@ RECIPE = """(
     ),
 )
 """
+
+
+ROUGH_GLASS = RECIPE.replace(
+    "body: (ior: 1.5),",
+    "body: (ior: 1.5, alpha: 0.2, distribution: Beckmann, masking: SmithSeparable,\n"
+    "           compensation: false),")
 
 
 CONDUCTOR = """(
@@ -89,6 +100,9 @@ def mitsuba(size, spp, out, scene_kind="sphere"):
                   @ T().scale([3.0, 3.0, 1.0]),
                   "emitter": {"type": "area", "radiance": {"type": "rgb", "value": [1, 1, 1]}}},
     }
+    if scene_kind == "rough-glass":
+        sphere_scene["sphere"]["bsdf"] = {"type": "roughdielectric", "distribution": "beckmann",
+                                          "alpha": 0.2, "int_ior": 1.5, "ext_ior": 1.0}
     scene = mi.load_dict({
         "type": "scene",
         "integrator": {"type": "stokes", "integrator": {"type": "path", "max_depth": 16}},
@@ -120,7 +134,7 @@ def lapidary(size, spp, out, scene_kind="sphere"):
     imgs = {}
     for a in (0, 90, 45, 135):
         recipe = out / f"sphere-{a}.ron"
-        text = CONDUCTOR if scene_kind == "conductor" else RECIPE
+        text = {"conductor": CONDUCTOR, "rough-glass": ROUGH_GLASS}.get(scene_kind, RECIPE)
         recipe.write_text(text.format(analyser=float(a), size=size, spp=spp))
         exr = out / f"lapidary-{a}.exr"
         # The conductor's index is an RGB one: its polarisation runs on RGB paths.
@@ -142,7 +156,8 @@ def main():
     ap.add_argument("out", nargs="?", default=str(ROOT / "target" / "mitsuba-polarised"))
     ap.add_argument("--spp", type=int, default=256)
     ap.add_argument("--size", type=int, default=96)
-    ap.add_argument("--scene", choices=("sphere", "conductor"), default="sphere")
+    ap.add_argument("--scene", choices=("sphere", "conductor", "rough-glass"),
+                    default="sphere")
     a = ap.parse_args()
     out = Path(a.out) / a.scene
     out.mkdir(parents=True, exist_ok=True)

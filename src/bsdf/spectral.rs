@@ -71,6 +71,14 @@ pub trait Scatter<S: Spectral> {
     fn conductor_ior(&self, _channel: usize, _lambda: &S::Wavelengths) -> Option<(f32, f32)> {
         None
     }
+
+    /// For a bare rough dielectric interface (Walter et al. 2007), its relative IOR (below over
+    /// above) at the wavelength of `channel`; `None` for any other model and for a channel the
+    /// path no longer carries. Polarised transport refracts and reflects at each micro-facet by
+    /// Fresnel's Mueller matrix instead of depolarising. By default none.
+    fn rough_interface_eta(&self, _channel: usize, _lambda: &S::Wavelengths) -> Option<f32> {
+        None
+    }
 }
 
 impl Scatter<RgbSample> for Bsdf {
@@ -106,6 +114,12 @@ impl Scatter<RgbSample> for Bsdf {
             Bsdf::Layered(l) if l.levels.is_empty() => {
                 <Bsdf as Scatter<RgbSample>>::conductor_ior(&l.base, channel, &RgbWavelengths)
             }
+            _ => None,
+        }
+    }
+    fn rough_interface_eta(&self, _channel: usize, _: &RgbWavelengths) -> Option<f32> {
+        match self {
+            Bsdf::Dielectric(b) => Some(b.eta),
             _ => None,
         }
     }
@@ -258,6 +272,17 @@ impl Scatter<HeroSample> for Bsdf {
             Bsdf::Layered(l) if l.levels.is_empty() => {
                 <Bsdf as Scatter<HeroSample>>::conductor_ior(&l.base, channel, lambda)
             }
+            _ => None,
+        }
+    }
+    fn rough_interface_eta(&self, channel: usize, lambda: &HeroWavelengths) -> Option<f32> {
+        match self {
+            Bsdf::Dielectric(_) if !(lambda.pdf[channel] > 0.0) => None,
+            // The wavelength's own index, as `rough_dispersive` evaluates the interface.
+            Bsdf::Dielectric(b) => Some(match b.dispersion {
+                None => b.eta,
+                Some(law) => law.eta_at(lambda.lambda[channel]),
+            }),
             _ => None,
         }
     }

@@ -28,6 +28,7 @@ pub mod boundary;
 pub mod crystal;
 pub mod cvec;
 pub mod etendue;
+pub mod event;
 pub mod fresnel;
 pub mod interference;
 pub mod mueller;

@@ -16,7 +16,7 @@
 //! `k = ((1, w₁, w₂, w₃) · N)₀` and the new ratios. Where polarisation cannot matter the
 //! correction is exactly 1: a path whose ratios are zero (unpolarised so far) has `k = N₀₀ = 1`.
 //! A depolarising vertex (`M = f · diag(1, 0, 0, 0)`: Lambert, the layered materials as the
-//! course models them, media, rough surfaces here) zeroes the ratios.
+//! course models them, media, platelets) zeroes the ratios.
 //!
 //! For a physical row `|(w₁, w₂, w₃)| ≤ 1` (an analyser followed by physical elements stays one),
 //! so `k ∈ [0, 2]`: the correction never turns a throughput negative.
@@ -26,11 +26,8 @@
 //! `x` kept here; at an interface `x` is turned to `s`, the normal of the plane of incidence.
 
 use super::Mueller;
-use super::fresnel;
+pub use super::event::{Interface, InterfaceEvent, MAX_CHANNELS};
 use glam::Vec3;
-
-/// Most channels a transported value has (four hero wavelengths; three RGB channels).
-pub const MAX_CHANNELS: usize = 4;
 
 /// The polarisation state of a camera path (module docs).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -47,15 +44,6 @@ pub struct PathPolarisation {
     /// boundary that made it knew it (zero otherwise): a biaxial crystal's ray does not always
     /// name one wave (near an optic axis two normals of a sheet share a ray).
     pub normal: Vec3,
-}
-
-/// An interface event's kind.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Interface {
-    /// Specular reflection.
-    Reflection,
-    /// Specular refraction.
-    Refraction,
 }
 
 impl PathPolarisation {
@@ -240,88 +228,13 @@ pub fn turn(from: Vec3, to: Vec3, d: Vec3) -> [f32; 2] {
     [c, s]
 }
 
-/// An interface event's frame and Fresnel matrices per channel, computed once for every row that
-/// takes it ([`PathPolarisation::take`]).
-#[derive(Clone, Copy, Debug)]
-pub struct InterfaceEvent {
-    /// The s axis (normal of the plane of incidence), the frame's axis after the event.
-    pub(super) s: Vec3,
-    /// The direction the light leaves along.
-    pub(super) wo: Vec3,
-    /// Per channel: `None` for a channel the path no longer carries, `Some(None)` where nothing
-    /// passes (total internal reflection for a refraction), else the Mueller matrix.
-    m: [Option<Option<Mueller>>; MAX_CHANNELS],
-}
-
-impl InterfaceEvent {
-    /// The event of [`PathPolarisation::interface`] (same arguments); `x` is a row's current axis,
-    /// which fixes the s axis at normal incidence (where every axis is one).
-    pub fn new(
-        n: Vec3,
-        wo: Vec3,
-        wi: Vec3,
-        eta: [Option<f32>; MAX_CHANNELS],
-        kind: Interface,
-        x: Vec3,
-    ) -> InterfaceEvent {
-        let s = s_axis(n, wo, x);
-        let cos_i = f64::from(wi.dot(n).abs()).min(1.0);
-        let m = eta.map(|e| {
-            e.map(|e| match kind {
-                Interface::Reflection => Some(fresnel::dielectric_reflection(cos_i, f64::from(e))),
-                Interface::Refraction => fresnel::dielectric_transmission(cos_i, f64::from(e)),
-            })
-        });
-        InterfaceEvent { s, wo, m }
-    }
-}
-
-impl InterfaceEvent {
-    /// Reflection off a conductor's micro-facet with unit normal `h` (the half vector of `wo` and
-    /// `wi`; the surface normal for a mirror): the light leaves along `wo`, arrived from `wi`,
-    /// and `nk[c]` is the conductor's relative complex IOR per channel (`None`: a channel the
-    /// path no longer carries). The facet's plane of incidence sets the frame, as for a rough
-    /// conductor in Mitsuba 3's polarised variants (Jakob et al. 2022): a rough conductor is a
-    /// mixture of mirrors, each polarising by its own Fresnel matrix.
-    pub fn conductor(
-        h: Vec3,
-        wo: Vec3,
-        wi: Vec3,
-        nk: [Option<(f32, f32)>; MAX_CHANNELS],
-        x: Vec3,
-    ) -> InterfaceEvent {
-        let s = s_axis(h, wo, x);
-        let cos_i = f64::from(wi.dot(h).abs()).min(1.0);
-        let m = nk.map(|v| {
-            v.map(|(n, k)| {
-                Some(fresnel::conductor_reflection(
-                    cos_i,
-                    f64::from(n),
-                    f64::from(k),
-                ))
-            })
-        });
-        InterfaceEvent { s, wo, m }
-    }
-}
-
-/// The s axis of an event at normal `n` with the light leaving along `wo`: the normal of the
-/// plane of incidence, or a row's axis `x` (made across `wo`) at normal incidence, where every
-/// axis is one.
-fn s_axis(n: Vec3, wo: Vec3, x: Vec3) -> Vec3 {
-    n.cross(wo).try_normalize().unwrap_or_else(|| {
-        (x - wo * x.dot(wo))
-            .try_normalize()
-            .unwrap_or_else(|| wo.any_orthonormal_vector())
-    })
-}
-
 /// The intensity an ideal linear polariser passes of unpolarised light.
 pub const ANALYSER_TRANSMITTANCE: f32 = 0.5;
 
 #[cfg(test)]
 mod tests {
     use super::super::Stokes;
+    use super::super::fresnel;
     use super::*;
     use std::f64::consts::PI;
 

@@ -3,7 +3,7 @@
 //! SIGGRAPH 1995: power heuristic, β = 2): next-event estimation against BSDF sampling, and the
 //! manifold walks against BSDF sampling of the same chains ([`super::manifold`]).
 
-use super::metal::{NeePolarisation, conductor_nee};
+use super::facet::{NeePolarisation, facet_nee};
 use super::path::{PathSample, PathState};
 use super::shading::SurfaceBsdf;
 use super::world::{LightRef, World};
@@ -101,7 +101,7 @@ where
                 LightRef::Environment => None,
             };
             let dirs = (sb.frame.to_world(wo_local), ls.wi);
-            conductor_nee::<S>(p, sb, dirs, polariser, &path.lambda)
+            facet_nee::<S>(p, sb, dirs, polariser, &path.lambda)
         }
     {
         *rows = r.rows.map(|kf| (path.gathered(c), kf));

@@ -1,7 +1,8 @@
-//! A bare conductor's polarising vertex (docs/polarisation.md, "Bare conductors"): each
-//! micro-facet reflects by Fresnel's Mueller matrix for the conductor's complex index, in the
-//! frame of its own plane of incidence — in BSDF sampling ([`super::polarised::polarise`]) and in
-//! light sampling ([`super::direct::direct_light`]).
+//! A micro-facet surface's polarising vertex (docs/polarisation.md, "Bare conductors" and
+//! "Rough dielectric boundaries"): each micro-facet reflects (a bare conductor's, by Fresnel's
+//! Mueller matrix for its complex index) or reflects and refracts (a rough dielectric's, by the
+//! dielectric's matrices) in the frame of its own plane of incidence — in BSDF sampling
+//! ([`super::polarised::polarise`]) and in light sampling ([`super::direct::direct_light`]).
 
 use super::shading::SurfaceBsdf;
 use crate::bsdf::{Bsdf, Scatter};
@@ -10,10 +11,11 @@ use crate::polarisation::transport::{InterfaceEvent, MAX_CHANNELS, PathPolarisat
 use crate::spectrum::Spectral;
 use glam::Vec3;
 
-/// The reflection off a bare conductor at `sb` of light arriving from `wi` and leaving along
-/// `wo` (world, unit): its facet's event (the half vector of the two directions) for a row whose
-/// axis is `x`; `None` if `sb` is no bare conductor or the directions are opposite.
-pub(crate) fn conductor_event<S: Spectral>(
+/// The scattering at a micro-facet surface `sb` of light arriving from `wi` and leaving along
+/// `wo` (world, unit), for a row whose axis is `x`: a bare conductor's reflection off the facet
+/// of the half vector, or a bare rough dielectric's reflection or refraction off the facet of
+/// the generalised half vector; `None` if `sb` is neither, or where the facet is undefined.
+pub(crate) fn facet_event<S: Spectral>(
     sb: &SurfaceBsdf<'_>,
     (wo, wi): (Vec3, Vec3),
     lambda: &S::Wavelengths,
@@ -22,9 +24,17 @@ pub(crate) fn conductor_event<S: Spectral>(
 where
     Bsdf: Scatter<S>,
 {
-    let nk = conductor_nk::<S>(sb, lambda)?;
-    let h = (wo + wi).try_normalize()?;
-    Some(InterfaceEvent::conductor(h, wo, wi, nk, x))
+    if let Some(nk) = conductor_nk::<S>(sb, lambda) {
+        let h = (wo + wi).try_normalize()?;
+        return Some(InterfaceEvent::conductor(h, wo, wi, nk, x));
+    }
+    sb.rough_interface_eta::<S>(0, lambda)?;
+    let eta: [Option<f32>; MAX_CHANNELS] = std::array::from_fn(|c| {
+        (c < S::CHANNELS)
+            .then(|| sb.rough_interface_eta::<S>(c, lambda))
+            .flatten()
+    });
+    InterfaceEvent::rough_dielectric(sb.frame.n, wo, wi, eta, x)
 }
 
 /// A bare conductor's relative complex IOR per channel (`None` for a channel the path no longer
@@ -63,10 +73,11 @@ pub(crate) struct NeeRead {
 }
 
 /// A light sample (light arriving from the unit `wi`, leaving toward the camera along the unit
-/// `wo`, both world) off a bare conductor at `sb`: its Fresnel matrix read by the rows, and the
-/// light's own polarisation when it shines through a `polariser` (axis, world, unit); `None`
-/// when `sb` is no bare conductor (the contribution stays the scalar code's).
-pub(crate) fn conductor_nee<S: Spectral>(
+/// `wo`, both world) off a micro-facet surface at `sb` ([`facet_event`]): its Fresnel matrix
+/// read by the rows, and the light's own polarisation when it shines through a `polariser`
+/// (axis, world, unit); `None` when `sb` is neither a bare conductor nor a bare rough dielectric
+/// (the contribution stays the scalar code's).
+pub(crate) fn facet_nee<S: Spectral>(
     polar: &NeePolarisation<'_>,
     sb: &SurfaceBsdf<'_>,
     (wo, wi): (Vec3, Vec3),
@@ -76,7 +87,7 @@ pub(crate) fn conductor_nee<S: Spectral>(
 where
     Bsdf: Scatter<S>,
 {
-    let event = conductor_event::<S>(sb, (wo, wi), lambda, polar.pol.x)?;
+    let event = facet_event::<S>(sb, (wo, wi), lambda, polar.pol.x)?;
     let mut row = *polar.pol;
     let mut k = row.take(&event);
     if let Some(axis) = polariser {

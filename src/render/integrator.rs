@@ -64,9 +64,9 @@
 use super::direct::{
     Strategy, area_emission_weight, direct_light, emission_weight, manifold_weight,
 };
+use super::facet::NeePolarisation;
 use super::manifold;
 use super::manifold::{Chain, WalkNumbers, WalkVertex};
-use super::metal::NeePolarisation;
 use super::path::{ManifoldVertex, PathSample, PathState, keep_off_the_boundary};
 use super::polarised::{
     StokesAov, crystal_boundary, crystal_sample, pleochroic_segment, pleochroic_transmittance,

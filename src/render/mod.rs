@@ -17,6 +17,7 @@
 pub mod camera;
 pub mod camera_path;
 pub mod direct;
+mod facet;
 pub mod film;
 pub mod filter;
 pub mod fixed;
@@ -24,7 +25,6 @@ pub mod integrator;
 pub mod lanes;
 pub mod manifold;
 pub mod memory;
-mod metal;
 pub mod output;
 pub mod part;
 pub mod path;

@@ -1,7 +1,7 @@
 //! The path loop's polarised vertex ([`crate::polarisation::transport`]): what a BSDF-sampled
 //! vertex does to the camera's Stokes row, and a doubly refractive boundary's sample.
 
-use super::metal::conductor_event;
+use super::facet::facet_event;
 use super::path::PathState;
 use super::shading::SurfaceBsdf;
 use super::world::CrystalOptics;
@@ -81,13 +81,13 @@ pub(super) fn stokes_add<S: Spectral>(aov: &mut Option<StokesAov<S>>, added: S) 
 }
 
 /// The Stokes row's update at a BSDF-sampled vertex: Fresnel's Mueller matrix at a smooth
-/// dielectric interface and at a bare conductor's facet (the throughput corrected per channel),
-/// depolarisation anywhere else; the Stokes AOVs' rows alike.
+/// dielectric interface and at a bare conductor's or rough dielectric's facet (the throughput
+/// corrected per channel), depolarisation anywhere else; the Stokes AOVs' rows alike.
 ///
 /// # Arguments
 /// * `wo` – the direction the light leaves toward the previous vertex (world, unit).
 /// * `above` – whether `wo` lies above the interface's frame (`z > 0`).
-/// * `conductors` – whether a bare conductor polarises here (not inside a crystal, where the
+/// * `facets` – whether a micro-facet surface polarises here (not inside a crystal, where the
 ///   path carries one of the crystal's waves).
 #[allow(clippy::too_many_arguments)]
 #[inline]
@@ -99,13 +99,13 @@ pub(super) fn polarise<S: Spectral>(
     bs: &BsdfSample<S>,
     wo: Vec3,
     above: bool,
-    conductors: bool,
+    facets: bool,
 ) where
     Bsdf: Scatter<S>,
 {
     use crate::polarisation::transport::Interface;
-    let event = if conductors && !bs.flags.is_transmission() {
-        conductor_event::<S>(sb, (wo, bs.wi), &path.lambda, pol.x)
+    let event = if facets {
+        facet_event::<S>(sb, (wo, bs.wi), &path.lambda, pol.x)
     } else {
         None
     };

@@ -143,6 +143,23 @@ impl<'a> SurfaceBsdf<'a> {
         <Bsdf as Scatter<S>>::conductor_ior(self.bxdf, channel, lambda)
     }
 
+    /// A bare rough dielectric interface's relative IOR (below over above the frame's `z`) at
+    /// the wavelength of `channel` ([`Scatter::rough_interface_eta`]); `None` for any other model.
+    #[inline]
+    pub fn rough_interface_eta<S: Spectral>(
+        &self,
+        channel: usize,
+        lambda: &S::Wavelengths,
+    ) -> Option<f32>
+    where
+        Bsdf: Scatter<S>,
+    {
+        if self.fluorescent.is_some() {
+            return None;
+        }
+        <Bsdf as Scatter<S>>::rough_interface_eta(self.bxdf, channel, lambda)
+    }
+
     /// Density of `wi_local` (local frame) from `wo_local`.
     #[inline]
     pub fn pdf<S: Spectral>(&self, wo_local: Vec3, wi_local: Vec3, lambda: &S::Wavelengths) -> f32

@@ -182,29 +182,44 @@ fn light_prefilter_runs_only_for_rgb_renders_under_spectral_lights() {
 }
 
 #[test]
-fn polarisation_code_changes_nothing_without_a_smooth_boundary_or_polariser() {
+fn polarisation_code_changes_nothing_without_a_polarising_vertex() {
     // Polarised transport forced on: every vertex of these scenes depolarises (Lambert, layered
-    // stacks — a varnished metal among them —, a rough body boundary and its scattering medium),
-    // so the Stokes row stays zero and every throughput correction is exactly 1. (A bare metal
-    // polarises: `tests/polarisation/conductor.rs`.)
-    let rough_body = scene(
-        r#"(materials: {
-               "body": (coats: [(ior: 1.5, roughness: 2.0, thickness: 1.0, tint: Rgb(0.9, 0.6, 0.8))],
-                        base: Lambert(albedo: Gray(0.6))),
-               "glitter": (coats: [(ior: 1.5, roughness: 1.0)],
-                           base: Conductor(metal: Silver, roughness: 2.0)) },
-            body: (ior: 1.55, roughness: 3.0,
-                   medium: (colour: Srgb(0.9, 0.7, 0.6), distance: 1.0, scattering: (2.0, 2.0, 2.0))),
-            surface: Overlay(
-                under: Switch(by: Marble(scale: 0.5), stops: [(0.0, Material("body")), (0.4, Body)]),
-                over: Voronoi(scale: 0.06, fill: 0.1, entries: [(1.0, Material("glitter"))])))"#,
+    // stacks — a varnished metal among them), so the Stokes row stays zero and every throughput
+    // correction is exactly 1. (A bare metal polarises: `tests/polarisation/conductor.rs`; so
+    // does a body's boundary, smooth or rough: `tests/polarisation/rough_dielectric.rs`.)
+    let surface = r#"(materials: {
+           "body": (coats: [(ior: 1.5, roughness: 2.0, thickness: 1.0, tint: Rgb(0.9, 0.6, 0.8))],
+                    base: Lambert(albedo: Gray(0.6))),
+           "glitter": (coats: [(ior: 1.5, roughness: 1.0)],
+                       base: Conductor(metal: Silver, roughness: 2.0)) },
+        {body}
+        surface: Overlay(
+            under: Switch(by: Marble(scale: 0.5), stops: [(0.0, Material("body")), (0.4, {under})]),
+            over: Voronoi(scale: 0.06, fill: 0.1, entries: [(1.0, Material("glitter"))])))"#;
+    let layered = scene(
+        &surface
+            .replace("{body}", "")
+            .replace("{under}", r#"Material("glitter")"#),
     );
-    assert!(!rough_body.effects.called(Effect::Polarisation));
+    assert!(!layered.effects.called(Effect::Polarisation));
     assert_untouched(
         Effect::Polarisation,
-        "a rough translucent body under layered materials",
-        &rough_body,
+        "layered materials and a varnished metal",
+        &layered,
     );
+    // A rough translucent body's boundary (with a scattering medium inside) polarises: forced
+    // on, its pixels change.
+    let rough_body = scene(&surface.replace("{under}", "Body").replace(
+        "{body}",
+        "body: (ior: 1.55, roughness: 3.0,
+                medium: (colour: Srgb(0.9, 0.7, 0.6), distance: 1.0, scattering: (2.0, 2.0, 2.0))),",
+    ));
+    assert!(!rough_body.effects.called(Effect::Polarisation));
+    let (n, _) = differences(
+        &film(&rough_body),
+        &film(&forced(&rough_body, Effect::Polarisation, true)),
+    );
+    assert!(n >= 20, "a rough body's boundary: only {n} pixels change");
     assert_untouched(
         Effect::Polarisation,
         "the opaque Sunstone",
