@@ -27,6 +27,7 @@ pub mod dielectric;
 pub mod dispersion;
 pub mod fastmath;
 pub mod fresnel;
+mod hero;
 pub mod interface_energy;
 pub mod lambert;
 pub mod layered;
