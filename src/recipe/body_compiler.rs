@@ -96,46 +96,28 @@ impl Compiler<'_> {
         }
         if shown {
             self.effects.turn_on(Effect::Transmission, place.clone());
-            if body.crystal.is_some() {
-                let c = r
+            // Each effect is named by the body's key that calls for it, at that key's line.
+            let place = |keys: &[&str], name: &str| {
+                let e = r
                     .source
-                    .find_from(at.unwrap_or(0), &["crystal", ":"])
-                    .or(at);
-                let e = r.source.error(c, "");
-                self.effects.turn_on(
-                    Effect::Polarisation,
-                    format!("body.crystal ({}:{})", e.file, e.line),
-                );
+                    .error(r.source.find_from(at.unwrap_or(0), keys).or(at), "");
+                format!("body.{name} ({}:{})", e.file, e.line)
+            };
+            if body.crystal.is_some() {
+                let p = place(&["crystal", ":"], "crystal");
+                self.effects.turn_on(Effect::Polarisation, p);
             }
             if body.crystal.is_some_and(|c| c.thin_nm.is_some()) {
-                let d = r
-                    .source
-                    .find_from(at.unwrap_or(0), &["thin_section", ":"])
-                    .or(at);
-                let e = r.source.error(d, "");
-                self.effects.turn_on(
-                    Effect::Spectral,
-                    format!("body.crystal.thin_section ({}:{})", e.file, e.line),
-                );
+                let p = place(&["thin_section", ":"], "crystal.thin_section");
+                self.effects.turn_on(Effect::Spectral, p);
             }
             if let Some(key) = desc.crystal.as_ref().and_then(|c| c.own_dispersion()) {
-                let d = r.source.find_from(at.unwrap_or(0), &[key, ":"]).or(at);
-                let e = r.source.error(d, "");
-                self.effects.turn_on(
-                    Effect::Spectral,
-                    format!("body.crystal.{key} ({}:{})", e.file, e.line),
-                );
+                let p = place(&[key, ":"], &format!("crystal.{key}"));
+                self.effects.turn_on(Effect::Spectral, p);
             }
             if body.dispersion.is_some() {
-                let d = r
-                    .source
-                    .find_from(at.unwrap_or(0), &["dispersion", ":"])
-                    .or(at);
-                let e = r.source.error(d, "");
-                self.effects.turn_on(
-                    Effect::Spectral,
-                    format!("body.dispersion ({}:{})", e.file, e.line),
-                );
+                let p = place(&["dispersion", ":"], "dispersion");
+                self.effects.turn_on(Effect::Spectral, p);
             }
             for (key, given) in [
                 (
@@ -148,36 +130,21 @@ impl Compiler<'_> {
                 ),
             ] {
                 if given {
-                    let d = r.source.find_from(at.unwrap_or(0), &[key, ":"]).or(at);
-                    let e = r.source.error(d, "");
-                    self.effects.turn_on(
-                        Effect::Spectral,
-                        format!("body.medium.{key} ({}:{})", e.file, e.line),
-                    );
+                    let p = place(&[key, ":"], &format!("medium.{key}"));
+                    self.effects.turn_on(Effect::Spectral, p);
                 }
             }
             if !body.platelets.is_empty() {
-                let p = r
-                    .source
-                    .find_from(at.unwrap_or(0), &["platelets", ":"])
-                    .or(at);
-                let e = r.source.error(p, "");
-                self.effects.turn_on(
-                    Effect::Platelets,
-                    format!("body.platelets ({}:{})", e.file, e.line),
-                );
+                let p = place(&["platelets", ":"], "platelets");
+                self.effects.turn_on(Effect::Platelets, p);
                 for (k, j, name, stack) in body.platelet_entries(body_index) {
                     let element = format!("body.platelets[{k}] entry {j} material \"{name}\"");
                     self.stack_effects(&element, name, stack);
                 }
             }
             if body.has_medium() {
-                let m = r.source.find_from(at.unwrap_or(0), &["medium", ":"]).or(at);
-                let e = r.source.error(m, "");
-                self.effects.turn_on(
-                    Effect::Medium,
-                    format!("body.medium ({}:{})", e.file, e.line),
-                );
+                let p = place(&["medium", ":"], "medium");
+                self.effects.turn_on(Effect::Medium, p);
             }
         } else {
             warnings.push(r.source.error(
