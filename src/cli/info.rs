@@ -164,77 +164,12 @@ pub fn describe(recipe: &GemRecipe, scene: &Scene, points: u32) -> String {
     }
     if let Some(b) = &s.body {
         let i = s.body_index() as usize;
-        let boundary = if b.alpha == 0.0 {
-            "smooth".to_string()
-        } else {
-            format!("{:?} α {:.4}, {:?}", b.distribution, b.alpha, b.masking)
-        };
-        let interior = match &b.medium {
-            Some(m) if b.has_medium() => format!(
-                "σa {:.4?}, σs {:.4?} per object unit, g {}{}",
-                m.sigma_a.0,
-                m.sigma_s.0,
-                m.g,
-                if b.has_measured_medium() {
-                    " (measured spectra; RGB shows their projection)"
-                } else {
-                    ""
-                }
-            ),
-            _ => "clear".into(),
-        };
-        let ior = match b.dispersion {
-            None => format!("{}", b.ior),
-            Some(law) => format!(
-                "{} (dispersive: n(486 nm) {:.4}, n(656 nm) {:.4}, Abbe {:.1})",
-                b.ior,
-                law.at(486.13),
-                law.at(656.27),
-                law.abbe()
-            ),
-        };
-        // A doubly refractive body: `ior` is ω or n_α.
-        let ior = match &b.crystal {
-            None => ior,
-            Some(c) => {
-                let absorbs = |names: &[&str]| {
-                    if !c.pleochroic() {
-                        return String::new();
-                    }
-                    let parts: Vec<String> = names
-                        .iter()
-                        .zip(&c.sigma)
-                        .map(|(n, s)| format!("σ{n} {:.3?}", s.0))
-                        .collect();
-                    format!("; pleochroic {} per object unit", parts.join(", "))
-                };
-                let absorbs = |names: &[&str]| match c.thin_nm {
-                    None => absorbs(names),
-                    Some(nm) => format!(
-                        "{}; thin section, {nm} nm per object unit: coherent, interference colours",
-                        absorbs(names)
-                    ),
-                };
-                match c.indices {
-                    crate::scene::body::Indices::Uniaxial { ne, axis } => format!(
-                        "ω {ior}, ε {ne} (uniaxial, axis {:.3?}{})",
-                        axis.to_array(),
-                        absorbs(&["ω", "ε"])
-                    ),
-                    crate::scene::body::Indices::Biaxial { beta, gamma, axes } => format!(
-                        "α {ior}, β {beta}, γ {gamma} (biaxial, X {:.3?}, Z {:.3?}{})",
-                        axes[0].to_array(),
-                        axes[2].to_array(),
-                        absorbs(&["α", "β", "γ"])
-                    ),
-                }
-            }
-        };
         let _ = writeln!(
             o,
-            "  {i:>3}  {:<width$}  {:>6.2}%  body: IOR {ior}, {boundary} boundary; interior {interior}",
+            "  {i:>3}  {:<width$}  {:>6.2}%  body: {}",
             "Body",
             100.0 * f64::from(counts[i]) / f64::from(points),
+            super::info_body::summary(b),
         );
         for (k, p) in b.platelets.iter().enumerate() {
             let orient = match p.orientation {

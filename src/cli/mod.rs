@@ -25,6 +25,7 @@ pub mod compare;
 pub mod cut;
 pub mod farm;
 pub mod info;
+mod info_body;
 pub mod knobs;
 pub mod load;
 pub mod map;
