@@ -131,7 +131,7 @@ impl MicrofacetDistribution {
                 // D is not 0 there for e ≤ 0, and both argument orders of a pair must agree).
                 // In f64 by the inline kernels of [`super::fastmath`]: `1 − s2` is exact there
                 // for every `s2` that matters, and one rounding to f32 at the end.
-                if blinn_underflows(e, s2, h.z) {
+                if fastmath::cos_power_underflows(e, s2, h.z) {
                     return 0.0;
                 }
                 let log_cos = if s2 < 0.5 {
@@ -350,29 +350,6 @@ impl MicrofacetDistribution {
     }
 }
 
-/// True when the Blinn lobe's `cos^e θh` is certain to round to 0 in `f32`, so that
-/// [`MicrofacetDistribution::d`] is 0 without its logarithm and exponential (a near-mirror lobe,
-/// e ~ 10⁴–10⁸, evaluated away from its peak: most light samples of a smooth coat).
-///
-/// The exponent `e ln cos θh` is bounded above by `−e s2 / 2` (`ln(1 − x) ≤ −x`) on the branch
-/// that reads `s2 = sin²θh`, and by `−e (1 − z)` (`ln z ≤ z − 1`) on the branch that reads `z`;
-/// either below −128 puts `e^…` under 2⁻¹⁵⁰ (`ln 2⁻¹⁵⁰ ≈ −103.97`), which rounds to 0 in `f32`,
-/// with a margin far beyond the kernels' 10⁻¹⁴ relative error. So the skip returns the same 0 the
-/// full evaluation gives, bit for bit. Only for `e > 0` (for `e ≤ 0` the lobe does not vanish).
-#[inline(always)]
-fn blinn_underflows(e: f32, s2: f32, z: f32) -> bool {
-    let e = f64::from(e);
-    if !(e > 0.0) {
-        return false;
-    }
-    let bound = if s2 < 0.5 {
-        0.5 * f64::from(s2)
-    } else {
-        1.0 - f64::from(z)
-    };
-    e * bound > 128.0
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -471,48 +448,5 @@ mod tests {
                 );
             }
         }
-    }
-
-    /// The underflow skip returns the 0 that the full evaluation rounds to, bit for bit, and
-    /// fires on most directions of a near-mirror lobe (else it would test nothing).
-    #[test]
-    fn blinn_underflow_skip_is_the_full_evaluation() {
-        let full = |e: f32, h: Vec3| -> f32 {
-            let s2 = crate::bsdf::sin2_theta(h);
-            let log_cos = if s2 < 0.5 {
-                0.5 * fastmath::ln(1.0 - f64::from(s2))
-            } else {
-                fastmath::ln(f64::from(h.z))
-            };
-            let d = (e + 2.0) / (2.0 * PI) * fastmath::exp(f64::from(e) * log_cos) as f32;
-            if d.is_finite() { d } else { 0.0 }
-        };
-        let mut skipped = 0;
-        let mut total = 0;
-        for m in [0.01f32, 0.1, 0.5, 1.0, 3.0, 10.0, 30.0, 60.0] {
-            let dist = MicrofacetDistribution::new(Distribution::Blinn, m);
-            let Ndf::Blinn { exponent: e } = dist.ndf else {
-                unreachable!()
-            };
-            // θh on a geometric ladder from 10⁻⁶ rad to the horizon, and at every φ-ish split.
-            for i in 0..4000 {
-                let t = 1e-6f64 * (std::f64::consts::FRAC_PI_2 / 1e-6).powf(i as f64 / 3999.0);
-                let phi = i as f64 * 0.618;
-                let h = Vec3::new(
-                    (t.sin() * phi.cos()) as f32,
-                    (t.sin() * phi.sin()) as f32,
-                    t.cos() as f32,
-                );
-                if h.z <= 0.0 {
-                    continue;
-                }
-                total += 1;
-                if blinn_underflows(e, crate::bsdf::sin2_theta(h), h.z) {
-                    skipped += 1;
-                }
-                assert_eq!(dist.d(h).to_bits(), full(e, h).to_bits(), "m={m} θ={t}");
-            }
-        }
-        assert!(skipped > total / 10, "{skipped} of {total}");
     }
 }
