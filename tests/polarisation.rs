@@ -17,7 +17,7 @@
 //! Renders are small (≤ 64 × 64) at fixed seeds, so every number is reproducible.
 
 use lapidary::recipe::GemRecipe;
-use lapidary::render::{Control, World, render_scene};
+use lapidary::render::{Control, Strategy, World, render_scene};
 use lapidary::scene::{Accuracy, Effect, Scene};
 
 /// Biaxial crystals and trichroism.
@@ -54,8 +54,17 @@ fn forced(scene: &Scene, on: bool) -> Scene {
 
 /// Mean radiance (channel 0) over the image and its standard error (from the pixels' spread).
 fn mean(scene: &Scene) -> (f64, f64) {
+    mean_by(scene, Control::default().strategy)
+}
+
+/// [`mean`] with light found by `strategy` (light sampling alone, BSDF sampling alone, or both).
+fn mean_by(scene: &Scene, strategy: Strategy) -> (f64, f64) {
     let world = World::new(scene).expect("world");
-    let r = render_scene(&world, scene, &Control::default());
+    let control = Control {
+        strategy,
+        ..Control::default()
+    };
+    let r = render_scene(&world, scene, &control);
     let v: Vec<f64> = r.film.rgb().iter().map(|p| f64::from(p[0])).collect();
     let n = v.len() as f64;
     let m = v.iter().sum::<f64>() / n;

@@ -2,8 +2,8 @@
 //! by Fresnel's Mueller matrix for the conductor's complex index, in BSDF sampling and in light
 //! sampling alike.
 
-use super::{compile, mean};
-use lapidary::render::{Control, Strategy, World, render_scene};
+use super::{compile, mean, mean_by};
+use lapidary::render::Strategy;
 use lapidary::scene::Scene;
 use num_complex::Complex64 as C;
 
@@ -89,17 +89,7 @@ fn light_against_bsdf_sampling(polariser: Option<f64>) {
     );
     let image = |analyser: f64, strategy: Strategy| {
         let s = slab(50.0, 8.0, Some(analyser), &lamp);
-        let world = World::new(&s).expect("world");
-        let control = Control {
-            strategy,
-            ..Control::default()
-        };
-        let r = render_scene(&world, &s, &control);
-        let v: Vec<f64> = r.film.rgb().iter().map(|p| f64::from(p[0])).collect();
-        let n = v.len() as f64;
-        let m = v.iter().sum::<f64>() / n;
-        let var = v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0);
-        (m, (var / n).sqrt())
+        mean_by(&s, strategy)
     };
     let mut means = Vec::new();
     for analyser in [0.0, 90.0] {

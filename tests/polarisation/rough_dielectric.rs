@@ -2,8 +2,8 @@
 //! reflects and refracts by Fresnel's Mueller matrices, in BSDF sampling and in light sampling
 //! alike.
 
-use super::{compile, forced, mean};
-use lapidary::render::{Control, Strategy, World, render_scene};
+use super::{compile, forced, mean, mean_by};
+use lapidary::render::Strategy;
 use lapidary::scene::Scene;
 
 /// The slab's index.
@@ -154,17 +154,7 @@ fn light_sampling_reads_the_facets_polarisation() {
 fn light_against_bsdf_sampling(theta: f64, light: &str, medium: &str, what: &str) {
     let image = |analyser: f64, strategy: Strategy| {
         let s = slab_spp(theta, 25.0, medium, Some(analyser), light, 512);
-        let world = World::new(&s).expect("world");
-        let control = Control {
-            strategy,
-            ..Control::default()
-        };
-        let r = render_scene(&world, &s, &control);
-        let v: Vec<f64> = r.film.rgb().iter().map(|p| f64::from(p[0])).collect();
-        let n = v.len() as f64;
-        let m = v.iter().sum::<f64>() / n;
-        let var = v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0);
-        (m, (var / n).sqrt())
+        mean_by(&s, strategy)
     };
     let mut means = Vec::new();
     for analyser in [0.0, 90.0] {
