@@ -158,13 +158,20 @@ fn reflection_at_brewster_angle_is_s_polarised() {
     }
 }
 
+/// Lossless spheres in the white furnace, polarisation forced on, through analysers: 1 without
+/// one and ½ with any — glass and diamond with smooth boundaries, and a rough (20°) glass
+/// sphere whose boundary returns its multiply scattered energy — within 5 standard errors
+/// below 1 % under (energy still trapped at depth 1 024) and 5 above. The rough one: each
+/// facet's reflection and refraction pass the same shares of s and p as a smooth boundary's, so
+/// unpolarised light stays unpolarised up to what masking shades differently in the two lobes
+/// and what the compensation lobe's matrix — the single facet's, a GUESS — does not conserve.
 #[test]
 fn white_furnace_stays_white_and_unpolarised() {
-    for ior in [1.5, 2.42] {
+    for body in ["(ior: 1.5)", "(ior: 2.42)", "(ior: 1.5, roughness: 20.0)"] {
         for analyser in [None, Some(0.0), Some(45.0), Some(100.0)] {
             let a = analyser.map_or(String::new(), |a: f64| format!("analyser: {a},"));
             let s = compile(&format!(
-                r#"(materials: {{}}, body: (ior: {ior}), surface: Body,
+                r#"(materials: {{}}, body: {body}, surface: Body,
                     stage: (shape: Sphere(radius: 1.0), ground: Off,
                             environment: Constant(Gray(1.0)), lights: [],
                             camera: Orthographic(from: (0.0, 0.0, 5.0), to: (0.0, 0.0, 0.0),
@@ -175,41 +182,12 @@ fn white_furnace_stays_white_and_unpolarised() {
             let s = forced(&s, true);
             let want = if analyser.is_some() { 0.5 } else { 1.0 };
             let (got, se) = mean(&s);
-            eprintln!("IOR {ior}, analyser {analyser:?}: {got:.5} ± {se:.5}");
+            eprintln!("body {body}, analyser {analyser:?}: {got:.5} ± {se:.5}");
             assert!(
                 got <= want + 5.0 * se && got >= want * 0.99 - 5.0 * se,
-                "IOR {ior}, analyser {analyser:?}: {got} ± {se} vs {want}"
+                "body {body}, analyser {analyser:?}: {got} ± {se} vs {want}"
             );
         }
-    }
-}
-
-/// A rough glass sphere (20°, its boundary's multiply scattered energy returned) in the white
-/// furnace, polarisation forced on, through analysers: 1 without one and ½ with any, within 5
-/// standard errors plus 1 % (each facet's reflection and refraction pass the same shares of s
-/// and p as a smooth boundary's, so unpolarised light stays unpolarised up to what masking
-/// shades differently in the two lobes and what the compensation lobe's matrix — the single
-/// facet's, a GUESS — does not conserve).
-#[test]
-fn a_rough_sphere_in_the_white_furnace_stays_white() {
-    for analyser in [None, Some(0.0), Some(60.0)] {
-        let a = analyser.map_or(String::new(), |a: f64| format!("analyser: {a},"));
-        let s = compile(&format!(
-            r#"(materials: {{}}, body: (ior: 1.5, roughness: 20.0), surface: Body,
-                stage: (shape: Sphere(radius: 1.0), ground: Off,
-                        environment: Constant(Gray(1.0)), lights: [],
-                        camera: Orthographic(from: (0.0, 0.0, 5.0), to: (0.0, 0.0, 0.0),
-                                             height: 2.0),
-                        {a}
-                        render: (width: 32, height: 32, spp: 64, max_depth: 1024)))"#
-        ));
-        let want = if analyser.is_some() { 0.5 } else { 1.0 };
-        let (got, se) = mean(&forced(&s, true));
-        eprintln!("rough sphere, analyser {analyser:?}: {got:.5} ± {se:.5}");
-        assert!(
-            (got - want).abs() <= 0.01 * want + 5.0 * se,
-            "analyser {analyser:?}: {got} ± {se} vs {want}"
-        );
     }
 }
 
