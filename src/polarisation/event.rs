@@ -219,4 +219,69 @@ mod tests {
         }
         assert!(checked.iter().all(|&c| c > 300), "{checked:?}");
     }
+
+    /// Hard cases: over chains of random rough-facet events — any two directions, on one side or
+    /// on both, down to 10⁻⁶ of grazing, indices 1.0001–4 from either side — every correction is
+    /// finite and within `[0, 2]`, every row physical, the frame across the light's new
+    /// direction; where no facet exists (a direction in the surface) there is no event.
+    #[test]
+    fn random_rough_chains_stay_physical() {
+        let mut rng = Rng::new(11);
+        let mut p = crate::polarisation::transport::PathPolarisation::analyser(Vec3::X, -Vec3::Z);
+        let mut wo = Vec3::Z;
+        let mut events = 0;
+        for i in 0..20_000 {
+            let n = Vec3::new(
+                rng.uniform() - 0.5,
+                rng.uniform() - 0.5,
+                rng.uniform() - 0.5,
+            )
+            .normalize_or(Vec3::Y);
+            // Mostly random, sometimes grazing to `n` within 10⁻⁶ … 10⁻².
+            let mut wi = Vec3::new(
+                rng.uniform() - 0.5,
+                rng.uniform() - 0.5,
+                rng.uniform() - 0.5,
+            )
+            .normalize_or(Vec3::X);
+            if i % 4 == 0 {
+                let g = 10f32.powf(-6.0 + 4.0 * rng.uniform()) * (rng.uniform() - 0.5).signum();
+                wi = (wi - n * wi.dot(n) + n * g).normalize();
+            }
+            let eta = 1.0001 + 2.9999 * rng.uniform();
+            let etas = [Some(eta), Some(eta * 1.01), None, None];
+            let Some(e) = InterfaceEvent::rough_dielectric(n, wo, wi, etas, p.x) else {
+                assert!(wo.dot(n) == 0.0 || wi.dot(n) == 0.0, "{wo} {wi} {n}");
+                continue;
+            };
+            let k = p.take(&e);
+            for c in 0..2 {
+                assert!(
+                    k[c].is_finite() && (0.0..=2.0 + 1e-4).contains(&k[c]),
+                    "{k:?}"
+                );
+                let w = p.w[c];
+                assert!(w.iter().all(|v| v.is_finite()));
+                assert!(
+                    w[0] * w[0] + w[1] * w[1] + w[2] * w[2] <= 1.0 + 1e-3,
+                    "{w:?}"
+                );
+            }
+            assert!(
+                p.x.dot(wo).abs() < 1e-3 && p.x.dot(wi).abs() < 1e-3,
+                "{} {wo}",
+                p.x
+            );
+            events += 1;
+            // The light's previous segment: it arrived along −wi.
+            wo = -wi;
+            if p.w[0] == [0.0; 3] {
+                p = crate::polarisation::transport::PathPolarisation::analyser(
+                    wo.any_orthonormal_vector(),
+                    -wo,
+                );
+            }
+        }
+        assert!(events > 19_000, "{events}");
+    }
 }
