@@ -36,6 +36,10 @@ mod rough_dielectric;
 #[path = "polarisation/etendue.rs"]
 mod etendue;
 
+/// The crystal events' one solve against the physical problem's own (reciprocity).
+#[path = "polarisation/reciprocity.rs"]
+mod reciprocity;
+
 fn compile(text: &str) -> Scene {
     GemRecipe::parse("polarisation.ron", text)
         .unwrap_or_else(|e| panic!("{e}"))

@@ -71,6 +71,19 @@ impl Biaxial {
     /// The unit ray (the index surface's normal) of the real wave vector `k` on the surface;
     /// `k`'s direction at a conical point, where the normal is not defined.
     pub fn ray(&self, k: DVec3) -> DVec3 {
+        let g = self.ray_unnormalised(k);
+        g.try_normalize().unwrap_or_else(|| k.normalize())
+    }
+
+    /// A number with the sign of [`Biaxial::ray`]`(k) · n`, without the normalisation.
+    pub fn ray_side(&self, k: DVec3, n: DVec3) -> f64 {
+        let g = self.ray_unnormalised(k);
+        let finite = g.length_squared() > 0.0 && g.is_finite();
+        if finite { g } else { k }.dot(n)
+    }
+
+    /// The index surface's normal at `k`, oriented along `k`, not normalised.
+    fn ray_unnormalised(&self, k: DVec3) -> DVec3 {
         let e = self.eps();
         let tr = e[0] + e[1] + e[2];
         let kk = k.length_squared();
@@ -81,8 +94,7 @@ impl Biaxial {
         for i in 0..3 {
             g += (kk * e[i] - e[i] * (tr - e[i])) * c[i] * self.axes[i];
         }
-        let g = if g.dot(k) < 0.0 { -g } else { g };
-        g.try_normalize().unwrap_or_else(|| k.normalize())
+        if g.dot(k) < 0.0 { -g } else { g }
     }
 
     /// The unit wave normal of the wave on sheet `slow` (false: the fast wave) whose ray is the
@@ -285,32 +297,6 @@ impl Biaxial {
             ds * C::new(1.0, -2e-3) - C::new(1e-4, 0.0),
         ];
         quartic::roots(c, Some(start))
-    }
-}
-
-/// A biaxial crystal's quartic roots (the normal components of its four waves) from the last
-/// solve of one boundary event, kept for the next solve of the same event: a camera path's
-/// physical problem has the opposite tangential wave vector of its adjoint one (the reversed
-/// waves), whose roots are the same negated (`F(−t + u m) = F(t − u m)`: Fresnel's equation is
-/// even in `k`). Local to one event, so a render's numbers never depend on what another path
-/// solved.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct Roots(Option<(DVec3, [C; 4])>);
-
-impl Roots {
-    /// The roots for tangential `t` on a boundary with normal `m`: the kept ones for `t` or,
-    /// negated, for `−t` (to 1e-9 of `|t|`: a reversed wave's tangential component, formed from
-    /// its index along its direction, repeats the adjoint's only to the roots' accuracy), else
-    /// solved; kept for the next call.
-    pub fn of(&mut self, x: &Biaxial, t: DVec3, m: DVec3) -> Option<[C; 4]> {
-        let tol = 1e-18 * (1.0 + t.length_squared());
-        let roots = match self.0 {
-            Some((t0, r)) if (t - t0).length_squared() <= tol => r,
-            Some((t0, r)) if (t + t0).length_squared() <= tol => r.map(|u| -u),
-            _ => x.normal_components(t, m)?,
-        };
-        self.0 = Some((t, roots));
-        Some(roots)
     }
 }
 

@@ -29,7 +29,7 @@ impl Boundary {
         for u in roots {
             let real = u.im.abs() <= 1e-9 * (1.0 + u.re.abs());
             let goes_down = if real {
-                x.ray(t + u.re * n).dot(n) < 0.0
+                x.ray_side(t + u.re * n, n) < 0.0
             } else {
                 u.im < 0.0
             };

@@ -18,7 +18,6 @@
 //! conservation for random crystals, axes and directions, reciprocity, and a biaxial crystal with
 //! two equal indices against the uniaxial closed forms.
 
-use super::biaxial::Roots;
 use super::cvec::{CVec, add, cross, cv, dot, norm, real, scale, solve4};
 pub use super::optics::Mode;
 use super::optics::Optics;
@@ -194,34 +193,18 @@ impl Boundary {
     /// power shares; `reference` fixes the s axis at normal incidence. `None` if the problem is
     /// singular (a grazing wave).
     pub fn solve(&self, incident: Incident, reference: DVec3) -> Option<[Outgoing; 4]> {
-        self.solve_in(incident, reference, &mut Roots::default())
-    }
-
-    /// [`Boundary::solve`] reusing the crystal's roots of an earlier solve of the same event
-    /// (`roots`, updated).
-    pub fn solve_in(
-        &self,
-        incident: Incident,
-        reference: DVec3,
-        roots: &mut Roots,
-    ) -> Option<[Outgoing; 4]> {
         let (t, s, index) = self.tangential(incident, reference);
-        let out = self.outgoing(t, s, roots)?;
+        let out = self.outgoing(t, s)?;
         self.amplitudes([incident], index, t, s, &out).map(|[o]| o)
     }
 
     /// [`Boundary::solve`] for an s and a p wave from outside along the unit `dir` (toward the
     /// crystal), `[s, p]` — the outgoing waves, which depend only on the tangential wave vector,
-    /// found once — reusing and updating `roots` as [`Boundary::solve_in`].
-    pub fn solve_sp_in(
-        &self,
-        dir: DVec3,
-        reference: DVec3,
-        roots: &mut Roots,
-    ) -> Option<[[Outgoing; 4]; 2]> {
+    /// found once.
+    pub fn solve_sp(&self, dir: DVec3, reference: DVec3) -> Option<[[Outgoing; 4]; 2]> {
         let inc = |mode| Incident::Outside { dir, mode };
         let (t, s, index) = self.tangential(inc(Mode::S), reference);
-        let out = self.outgoing(t, s, roots)?;
+        let out = self.outgoing(t, s)?;
         self.amplitudes([inc(Mode::S), inc(Mode::P)], index, t, s, &out)
     }
 
@@ -241,14 +224,14 @@ impl Boundary {
 
     /// The four waves leaving the boundary with tangential `t` (s axis `s`): `S`, `P` on the
     /// isotropic side, then the crystal's two.
-    fn outgoing(&self, t: DVec3, s: DVec3, roots: &mut Roots) -> Option<[Wave; 4]> {
+    fn outgoing(&self, t: DVec3, s: DVec3) -> Option<[Wave; 4]> {
         let [c0, c1] = match &self.crystal {
             Optics::Uniaxial(x) => [
                 self.crystal_wave(x, t, Mode::O, false, s),
                 self.crystal_wave(x, t, Mode::E, false, s),
             ],
             Optics::Biaxial(x) => {
-                let u = roots.of(x, t, self.normal)?;
+                let u = x.normal_components(t, self.normal)?;
                 self.biaxial_down(x, t, s, u)?
             }
         };

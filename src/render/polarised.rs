@@ -177,9 +177,9 @@ where
     let facing = if n.dot(wo) > 0.0 { n } else { -n };
     let normal = if outside { facing } else { -facing };
     let crystal_optics = crystal.at(no, S::wavelength_nm(lambda, 0));
-    // A biaxial boundary's normal made unit in f64 (an f32 normal is unit to 6e-8 only), so
-    // that a reversed wave's tangential component repeats the adjoint's and the event solves
-    // the crystal's quartic once (`boundary::Roots`); the uniaxial closed forms keep theirs.
+    // A biaxial boundary's normal made unit in f64 (an f32 normal is unit to 6e-8 only): the
+    // quartic of the waves' normal components takes a unit normal; the uniaxial closed forms
+    // keep theirs.
     let normal = match crystal_optics {
         Optics::Biaxial(_) => normal.normalize(),
         Optics::Uniaxial(_) => normal,

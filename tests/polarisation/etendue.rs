@@ -12,7 +12,7 @@
 //! tenth of that).
 
 use glam::{DVec3, Vec3};
-use lapidary::polarisation::biaxial::{Biaxial, Roots};
+use lapidary::polarisation::biaxial::Biaxial;
 use lapidary::polarisation::boundary::Boundary;
 use lapidary::polarisation::crystal::from_inside;
 use lapidary::polarisation::optics::Optics;
@@ -42,15 +42,12 @@ fn fluxes(crystal: Optics, k: usize) -> (f64, f64, f64) {
     let mut rng = Rng::new(41);
     let pi = std::f64::consts::PI;
     let mut outside = 0.0;
-    let mut roots = Roots::default();
     for i in 0..k {
         for j in 0..k {
             // Light arriving from the sky, travelling into the crystal along −normal's side.
             let d = -cosine_dir(normal, i, j, k, &mut rng);
             let reference = d.any_orthonormal_vector();
-            let [s, p] = b
-                .solve_sp_in(d, reference, &mut roots)
-                .expect("a solve from outside");
+            let [s, p] = b.solve_sp(d, reference).expect("a solve from outside");
             outside += 0.5 * (s[2].power + s[3].power + p[2].power + p[3].power);
         }
     }
