@@ -40,6 +40,10 @@ mod etendue;
 #[path = "polarisation/reciprocity.rs"]
 mod reciprocity;
 
+/// Platelets inside a crystal reflect by the conductor's matrix.
+#[path = "polarisation/crystal_platelets.rs"]
+mod crystal_platelets;
+
 fn compile(text: &str) -> Scene {
     GemRecipe::parse("polarisation.ron", text)
         .unwrap_or_else(|e| panic!("{e}"))

@@ -364,9 +364,10 @@ where
         // Inside the stone only a transmitting boundary can see a light (module docs).
         let sees_out = path.medium == MediumId::OUTSIDE || sb.flags().is_transmission();
         let nee = strategy != Strategy::BsdfOnly && !sb.flags().is_specular_only() && sees_out;
-        // Inside a crystal the path carries a wave, which a conductor's matrix would not keep:
-        // platelets there depolarise (docs/polarisation.md). (A conductor only reflects, so the
-        // medium is the same after the vertex's scattering.)
+        // Inside a crystal the path carries a wave: light samples there read no facet's matrix
+        // (only a transmitting vertex sees a light from inside, and a crystal's boundary is
+        // sampled by its own rule). A platelet's conductor polarises (below); the path then
+        // carries no wave until it takes one by its row (`polarised::take_wave`).
         let in_crystal = POL && world.crystal.is_some() && path.medium != MediumId::OUTSIDE;
         if nee {
             let polar = (POL && !in_crystal).then(|| NeePolarisation {
@@ -510,7 +511,8 @@ where
         if POL && crystal.is_none() {
             let rows = aov.as_mut().filter(|_| STOKES).map(|a| &mut a.rows);
             let above = wo_local.z > 0.0;
-            polarise(&mut pol, rows, &mut path, &sb, &bs, wo, above, !in_crystal);
+            let facets = !in_crystal || matches!(hit, Hit::Platelet { .. });
+            polarise(&mut pol, rows, &mut path, &sb, &bs, wo, above, facets);
         }
         path.platelet = match hit {
             Hit::Platelet { id, .. } => Some(id),

@@ -87,8 +87,8 @@ pub(super) fn stokes_add<S: Spectral>(aov: &mut Option<StokesAov<S>>, added: S) 
 /// # Arguments
 /// * `wo` – the direction the light leaves toward the previous vertex (world, unit).
 /// * `above` – whether `wo` lies above the interface's frame (`z > 0`).
-/// * `facets` – whether a micro-facet surface polarises here (not inside a crystal, where the
-///   path carries one of the crystal's waves).
+/// * `facets` – whether a micro-facet surface polarises here (inside a crystal only a
+///   platelet's conductor; the path then carries no wave until [`take_wave`]).
 #[allow(clippy::too_many_arguments)]
 #[inline]
 pub(super) fn polarise<S: Spectral>(
@@ -140,6 +140,10 @@ pub(super) fn polarise<S: Spectral>(
         return;
     };
     let k = pol.take(&event);
+    // A crystal's wave does not survive a platelet's conductor (which only reflects: the path
+    // stays in the crystal, carrying the row until it takes a wave again).
+    pol.mode = None;
+    pol.normal = Vec3::ZERO;
     if let Some(r) = rows {
         r.take(&event, k);
     }
@@ -189,6 +193,10 @@ where
         n1: 1.0,
         normal,
     };
+    // Inside, a polarised row without a wave (after a platelet) takes one first.
+    let mut rows = rows;
+    let channels = (!outside && pol.mode.is_none() && !pol.is_unpolarised())
+        .then(|| take_wave(&b.crystal, pol, rows.as_deref_mut(), -wo, f64::from(u.0)));
     let step = if outside {
         crystal::from_outside(&b, wo, pol, f64::from(u.0))?
     } else {
@@ -225,7 +233,8 @@ where
     };
     let spectral = S::WAVELENGTH_DIMENSIONS > 0;
     let w = step.weight as f32;
-    let weight = S::from_channels(|c| if c == 0 || !spectral { w } else { 0.0 });
+    let k = channels.unwrap_or([1.0; MAX_CHANNELS]);
+    let weight = S::from_channels(|c| if c == 0 || !spectral { w * k[c] } else { 0.0 });
     let cos = wi.dot(sb.frame.n).abs();
     let pdf = step.prob as f32;
     if !(w.is_finite() && w >= 0.0 && pdf > 0.0 && cos > 0.0) {
@@ -244,6 +253,58 @@ where
     })
 }
 
+/// Inside a crystal, a polarised camera row `pol` that carries no wave (after a platelet's
+/// reflection) takes one of the crystal's two waves along the unit `ray` (the camera path's
+/// direction), and the Stokes AOVs' `rows` with it; returns the factor of each channel's
+/// throughput. The light along the ray is the incoherent sum of the two waves, `Σₘ Lₘ (1, sₘ)`
+/// with `sₘ` wave `m`'s pure linear state (the two opposite: their fields are orthogonal), which
+/// the row reads as `Σₘ Lₘ (1 + w·sₘ)`. The path takes wave `m` with probability
+/// `(1 + w·sₘ) / 2` of channel 0's ratios (½ each for an unpolarised row) and carries its pure
+/// row, which reads `2 Lₘ`: weight 1 for channel 0, `(1 + w_c·sₘ) / (1 + w₀·sₘ)` for channel
+/// `c`, and each AOV row's factor changes by its reading over the sensor's. `u ∈ [0, 1)`.
+pub(super) fn take_wave(
+    optics: &Optics,
+    pol: &mut PathPolarisation,
+    rows: Option<&mut StokesRows>,
+    ray: glam::DVec3,
+    u: f64,
+) -> [f32; MAX_CHANNELS] {
+    let modes = optics.modes();
+    let light = (-ray).as_vec3();
+    let field = optics.field(ray, modes[0]).as_vec3();
+    // Each channel's reading of wave m's pure state: the row turned to the first wave's field
+    // (S1 there is the first wave's state, its negative the second's).
+    let reading = |p: &PathPolarisation, m: Mode| -> [f32; MAX_CHANNELS] {
+        let mut q = *p;
+        q.rotate_to(field, light);
+        let sign = if m == modes[0] { 1.0 } else { -1.0 };
+        std::array::from_fn(|c| (1.0 + sign * q.w[c][0]).max(0.0))
+    };
+    let mode = if u < 0.5 * f64::from(reading(pol, modes[0])[0]) {
+        modes[0]
+    } else {
+        modes[1]
+    };
+    let sensor = reading(pol, mode);
+    if let Some(r) = rows
+        && !r.settled
+    {
+        for j in 0..ROWS {
+            let own = reading(&r.rows[j], mode);
+            r.rescale(j, own, sensor);
+        }
+    }
+    let k = std::array::from_fn(|c| {
+        if sensor[0] > 0.0 {
+            sensor[c] / sensor[0]
+        } else {
+            0.0
+        }
+    });
+    *pol = crystal::pure_state(optics, ray, mode);
+    k
+}
+
 /// The transmittance over distance `t` of a pleochroic crystal for the wave the path's segment
 /// carries, the camera ray travelling along `dir` (unit). Uniaxial: `exp(−σ t)` with `σ = σ_ω`
 /// for the ordinary wave and `σ_ω cos² θ + σ_ε sin² θ` for the extraordinary, `θ` between its
@@ -258,7 +319,7 @@ where
 pub(super) fn pleochroic_transmittance<S: Spectral>(
     crystal: &CrystalOptics,
     pol: &mut PathPolarisation,
-    rows: Option<&mut StokesRows>,
+    mut rows: Option<&mut StokesRows>,
     dir: Vec3,
     t: f32,
     u: f32,
@@ -278,12 +339,19 @@ pub(super) fn pleochroic_transmittance<S: Spectral>(
     };
     let ray = dir.as_dvec3();
     let modes = optics.modes();
+    // A segment after a platelet's reflection takes a wave by the row's polarisation.
+    let mut channels = None;
     let mode = match pol.mode {
         Some(m) => m,
-        None => {
+        None if pol.is_unpolarised() => {
             let m = if u < 0.5 { modes[0] } else { modes[1] };
             *pol = crystal::pure_state(&optics, ray, m);
             m
+        }
+        None => {
+            let r = rows.as_deref_mut();
+            channels = Some(take_wave(&optics, pol, r, ray, f64::from(u)));
+            pol.mode.unwrap_or(modes[0])
         }
     };
     let sigma = match (mode, &optics) {
@@ -311,7 +379,11 @@ pub(super) fn pleochroic_transmittance<S: Spectral>(
     if let Some(r) = rows {
         r.follow(pol);
     }
-    S::from_unbounded(sigma, lambda).map(|s| (-s * t).exp())
+    let tr = S::from_unbounded(sigma, lambda).map(|s| (-s * t).exp());
+    match channels {
+        Some(k) => tr * S::from_channels(|c| k[c]),
+        None => tr,
+    }
 }
 
 /// Wavelengths (nm) a thin section's retardance is evaluated at in RGB transport, per channel:
