@@ -44,6 +44,10 @@ mod reciprocity;
 #[path = "polarisation/crystal_platelets.rs"]
 mod crystal_platelets;
 
+/// Pleochroism given as spectra, read per wavelength.
+#[path = "polarisation/measured_pleochroism.rs"]
+mod measured_pleochroism;
+
 fn compile(text: &str) -> Scene {
     GemRecipe::parse("polarisation.ron", text)
         .unwrap_or_else(|e| panic!("{e}"))

@@ -111,6 +111,13 @@ impl Compiler<'_> {
                 let p = place(&["thin_section", ":"], "crystal.thin_section");
                 self.effects.turn_on(Effect::Spectral, p);
             }
+            if body
+                .crystal
+                .is_some_and(|c| c.sigma_measured.iter().any(Option::is_some))
+            {
+                let p = place(&["pleochroism", ":"], "crystal.pleochroism");
+                self.effects.turn_on(Effect::Spectral, p);
+            }
             if let Some(key) = desc.crystal.as_ref().and_then(|c| c.own_dispersion()) {
                 let p = place(&[key, ":"], &format!("crystal.{key}"));
                 self.effects.turn_on(Effect::Spectral, p);

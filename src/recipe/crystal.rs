@@ -15,8 +15,8 @@
 //!     ne_dispersion: Some(Abbe(68.5))),                 // (ω's is the body's `dispersion`)
 //! ```
 
-use super::color::ColorDesc;
 use super::dispersion::DispersionDesc;
+pub use super::pleochroism::{PleochroismDesc, TrichroismDesc};
 use crate::bsdf::dispersion::Ior;
 use crate::color::Rgb;
 use serde::{Deserialize, Deserializer, Serialize};
@@ -24,7 +24,6 @@ use serde::{Deserialize, Deserializer, Serialize};
 ranged!(ne_range, "crystal.ne", 1.0001, 4.0);
 ranged!(beta_range, "crystal.beta", 1.0001, 4.0);
 ranged!(gamma_range, "crystal.gamma", 1.0001, 4.0);
-ranged!(pleochroism_distance, "pleochroism.distance", open 0.0, 1e4);
 ranged!(unit_nm_range, "thin_section.unit_nm", open 0.0, 1e7);
 
 /// The optics of a doubly refractive body.
@@ -105,77 +104,6 @@ pub struct ThinSectionDesc {
 /// Sin² of the smallest angle allowed between a biaxial crystal's `x_axis` and `z_axis` (5°).
 const MIN_AXES_SIN2: f32 = 0.007_596;
 
-/// What white light keeps of each channel after `distance` as an absorption coefficient per
-/// object unit, `−ln(colour)/distance`, or what is wrong with `name`.
-fn sigma(c: &ColorDesc, name: &str, distance: f32) -> Result<Rgb, String> {
-    let rgb = c.to_rgb().map_err(|e| format!("pleochroism.{name}: {e}"))?;
-    if rgb.0.iter().all(|v| *v > 0.0 && *v <= 1.0) {
-        Ok(rgb.map(|v| -v.ln() / distance))
-    } else {
-        Err(format!(
-            "pleochroism.{name} = {:?}: each channel must be in 0 <..= 1 (the share of white \
-             light kept after `distance`)",
-            rgb.0
-        ))
-    }
-}
-
-/// A dichroic crystal's absorption per wave, on top of the body's `medium`: the colour white
-/// light keeps after `distance` when it travels as the ordinary wave (ω) and as the
-/// extraordinary wave across the axis (ε, its field along the axis); an extraordinary wave at
-/// angle θ to the axis absorbs `σ_ω cos² θ + σ_ε sin² θ`.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct PleochroismDesc {
-    /// Colour of the ordinary wave after `distance` (each channel 0 <..= 1).
-    pub ordinary: ColorDesc,
-    /// Colour of the extraordinary wave (across the axis) after `distance`.
-    pub extraordinary: ColorDesc,
-    /// Object units, 0 <.. 1e4.
-    #[serde(deserialize_with = "pleochroism_distance")]
-    pub distance: f32,
-}
-
-impl PleochroismDesc {
-    /// The absorption coefficients per object unit `(σ_ω, σ_ε)`, or what is wrong.
-    pub fn coefficients(&self) -> Result<(Rgb, Rgb), String> {
-        Ok((
-            sigma(&self.ordinary, "ordinary", self.distance)?,
-            sigma(&self.extraordinary, "extraordinary", self.distance)?,
-        ))
-    }
-}
-
-/// A trichroic crystal's absorption, on top of the body's `medium`: the colour white light keeps
-/// after `distance` when it vibrates along X (`alpha`), Y (`beta`) and Z (`gamma`) — what a
-/// dichroscope shows looking along the other two axes. A wave whose unit displacement is `D̂`
-/// absorbs `Σ (D̂·aᵢ)² σᵢ` (the absorbing crystal's quadratic form, Born & Wolf, *Principles of
-/// Optics*, §15.6).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct TrichroismDesc {
-    /// Colour of light vibrating along X after `distance` (each channel 0 <..= 1).
-    pub alpha: ColorDesc,
-    /// Along Y.
-    pub beta: ColorDesc,
-    /// Along Z.
-    pub gamma: ColorDesc,
-    /// Object units, 0 <.. 1e4.
-    #[serde(deserialize_with = "pleochroism_distance")]
-    pub distance: f32,
-}
-
-impl TrichroismDesc {
-    /// The absorption coefficients per object unit `[σ_α, σ_β, σ_γ]`, or what is wrong.
-    pub fn coefficients(&self) -> Result<[Rgb; 3], String> {
-        Ok([
-            sigma(&self.alpha, "alpha", self.distance)?,
-            sigma(&self.beta, "beta", self.distance)?,
-            sigma(&self.gamma, "gamma", self.distance)?,
-        ])
-    }
-}
-
 /// A biaxial crystal's checks the fields cannot make alone: the keyword the error is at and what
 /// is wrong, or the orthonormal axes X, Y, Z.
 pub fn biaxial_axes(
@@ -252,8 +180,8 @@ impl CrystalDesc {
                 pleochroism: p,
                 thin_section,
             } => {
-                let (o, e) = match p.as_ref().map(|p| p.coefficients()) {
-                    None => (Rgb::ZERO, Rgb::ZERO),
+                let [o, e] = match p.as_ref().map(|p| p.coefficients()) {
+                    None => [(Rgb::ZERO, None); 2],
                     Some(r) => r.map_err(pleochroism)?,
                 };
                 let ne_law = law(ne_dispersion, "ne_dispersion", *ne)?;
@@ -282,7 +210,8 @@ impl CrystalDesc {
                         axis: glam::Vec3::new(axis.0, axis.1, axis.2).normalize(),
                     },
                     laws: [ne_law, None],
-                    sigma: [o, e, Rgb::ZERO],
+                    sigma: [o.0, e.0, Rgb::ZERO],
+                    sigma_measured: [o.1, e.1, None],
                     thin_nm: thin_section.as_ref().map(|t| t.unit_nm),
                 })
             }
@@ -298,7 +227,7 @@ impl CrystalDesc {
             } => {
                 let axes = biaxial_axes(ior, *beta, *gamma, *x_axis, *z_axis)?;
                 let sigma = match p.as_ref().map(|p| p.coefficients()) {
-                    None => [Rgb::ZERO; 3],
+                    None => [(Rgb::ZERO, None); 3],
                     Some(r) => r.map_err(pleochroism)?,
                 };
                 let laws = [
@@ -336,7 +265,8 @@ impl CrystalDesc {
                         axes,
                     },
                     laws,
-                    sigma,
+                    sigma: sigma.map(|s| s.0),
+                    sigma_measured: sigma.map(|s| s.1),
                     thin_nm: thin_section.as_ref().map(|t| t.unit_nm),
                 })
             }
@@ -444,28 +374,5 @@ mod tests {
             .compile(1.542, Ior::from_abbe(1.542, 10.0))
             .unwrap_err();
         assert_eq!(key, "gamma_dispersion");
-    }
-
-    #[test]
-    fn trichroic_colours_become_coefficients() {
-        let t = TrichroismDesc {
-            alpha: ColorDesc::Rgb(0.5, 0.5, 0.5),
-            beta: ColorDesc::Rgb(1.0, 1.0, 1.0),
-            gamma: ColorDesc::Rgb(0.25, 0.5, 1.0),
-            distance: 2.0,
-        };
-        let [a, b, g] = t.coefficients().unwrap();
-        assert!((a.0[0] - 0.5f32.ln().abs() / 2.0).abs() < 1e-6);
-        assert_eq!(b.0, [0.0; 3]);
-        assert!((g.0[0] - 4.0f32.ln() / 2.0).abs() < 1e-6 && g.0[2] == 0.0);
-        let bad = TrichroismDesc {
-            gamma: ColorDesc::Rgb(0.0, 0.5, 1.0),
-            ..t
-        };
-        assert!(
-            bad.coefficients()
-                .unwrap_err()
-                .contains("pleochroism.gamma")
-        );
     }
 }

@@ -25,6 +25,7 @@ mod map_compiler;
 pub mod material;
 mod platelet_compiler;
 pub mod platelets;
+pub mod pleochroism;
 mod resolve;
 mod shape;
 pub mod source;

@@ -61,6 +61,7 @@
 //!
 //! **Sample dimensions.** The slot layout is [`crate::sampler`]'s (written once there).
 
+use super::crystal_segment::{pleochroic_segment, pleochroic_transmittance};
 use super::direct::{
     Strategy, area_emission_weight, direct_light, emission_weight, manifold_weight,
 };
@@ -68,10 +69,7 @@ use super::facet::NeePolarisation;
 use super::manifold;
 use super::manifold::{Chain, WalkNumbers, WalkVertex};
 use super::path::{ManifoldVertex, PathSample, PathState, keep_off_the_boundary};
-use super::polarised::{
-    StokesAov, crystal_boundary, crystal_sample, pleochroic_segment, pleochroic_transmittance,
-    polarise, stokes_add,
-};
+use super::polarised::{StokesAov, crystal_boundary, crystal_sample, polarise, stokes_add};
 use super::shading::shade;
 use super::world::{Hit, LightRef, World};
 use crate::bsdf::{Bsdf, Scatter};
@@ -367,7 +365,7 @@ where
         // Inside a crystal the path carries a wave: light samples there read no facet's matrix
         // (only a transmitting vertex sees a light from inside, and a crystal's boundary is
         // sampled by its own rule). A platelet's conductor polarises (below); the path then
-        // carries no wave until it takes one by its row (`polarised::take_wave`).
+        // carries no wave until it takes one by its row (`crystal_segment::take_wave`).
         let in_crystal = POL && world.crystal.is_some() && path.medium != MediumId::OUTSIDE;
         if nee {
             let polar = (POL && !in_crystal).then(|| NeePolarisation {

@@ -16,6 +16,7 @@
 
 pub mod camera;
 pub mod camera_path;
+mod crystal_segment;
 pub mod direct;
 mod facet;
 pub mod film;

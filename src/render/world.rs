@@ -160,6 +160,9 @@ pub struct CrystalOptics {
     /// extraordinary wave across the axis; biaxial, of light vibrating along X, Y, Z (zero: not
     /// pleochroic).
     pub sigma: [Rgb; 3],
+    /// `sigma`'s spectra per world unit where the recipe gave spectra (read per wavelength by
+    /// spectral transport; `sigma` is their colours' coefficient).
+    pub sigma_measured: [Option<&'static crate::spectrum::measured::Measured>; 3],
     /// A thin section: nanometres of crystal per world unit (its two waves add coherently, its
     /// boundary refracts as an isotropic one of index `no`); `None`: a gem.
     pub thin_nm: Option<f32>,
@@ -297,35 +300,28 @@ impl World {
                     .length()
                     .max(f32::MIN_POSITIVE);
                 let to_world = |v: Vec3| stage.to_world.transform_vector3(v).normalize();
-                let sigma = c.sigma.map(|s| s * (1.0 / scale));
-                let thin_nm = c.thin_nm.map(|nm| nm / scale);
-                match c.indices {
-                    Indices::Uniaxial { ne, axis } => CrystalOptics {
-                        no: ior,
-                        birefringence: ne - ior,
-                        axis: to_world(axis),
-                        biaxial: None,
-                        sigma,
-                        thin_nm,
-                        laws: c.laws,
-                        body_law,
-                    },
+                let (birefringence, axis, biaxial) = match c.indices {
+                    Indices::Uniaxial { ne, axis } => (ne - ior, to_world(axis), None),
                     Indices::Biaxial { beta, gamma, axes } => {
                         // Orthonormal again in world space (Gram–Schmidt, X kept).
                         let x = to_world(axes[0]);
                         let z = to_world(axes[2]);
                         let z = (z - x * z.dot(x)).normalize();
-                        CrystalOptics {
-                            no: ior,
-                            birefringence: 0.0,
-                            axis: x,
-                            biaxial: Some(([beta - ior, gamma - ior], [x, z.cross(x), z])),
-                            sigma,
-                            thin_nm,
-                            laws: c.laws,
-                            body_law,
-                        }
+                        let principal = Some(([beta - ior, gamma - ior], [x, z.cross(x), z]));
+                        (0.0, x, principal)
                     }
+                };
+                CrystalOptics {
+                    no: ior,
+                    birefringence,
+                    axis,
+                    biaxial,
+                    sigma: c.sigma.map(|s| s * (1.0 / scale)),
+                    sigma_measured: (c.sigma_measured)
+                        .map(|m| m.map(|m| m.scaled(1.0 / scale).intern())),
+                    thin_nm: c.thin_nm.map(|nm| nm / scale),
+                    laws: c.laws,
+                    body_law,
                 }
             });
         if polarised && let Some(m) = inside.manifold.as_mut() {

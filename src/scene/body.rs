@@ -56,6 +56,9 @@ pub struct Crystal {
     /// Absorption per object unit on top of the medium's, per principal wave: uniaxial
     /// `[ω, ε across the axis, 0]`; biaxial `[α, β, γ]` (light vibrating along X, Y, Z).
     pub sigma: [Rgb; 3],
+    /// `sigma`'s spectra where the recipe gave a spectrum (`sigma` is then the coefficient of
+    /// its colour's projection), read per wavelength by spectral transport.
+    pub sigma_measured: [Option<&'static Measured>; 3],
     /// A thin section ([`crate::recipe::crystal::ThinSectionDesc`]): nanometres of crystal per
     /// object unit; its two waves add coherently. `None`: a gem, incoherent.
     pub thin_nm: Option<f32>,
