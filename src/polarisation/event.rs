@@ -20,7 +20,7 @@ pub enum Interface {
 }
 
 /// An interface event's frame and Fresnel matrices per channel, computed once for every row that
-/// takes it ([`PathPolarisation::take`]).
+/// takes it ([`super::transport::PathPolarisation::take`]).
 #[derive(Clone, Copy, Debug)]
 pub struct InterfaceEvent {
     /// The s axis (normal of the plane of incidence), the frame's axis after the event.
@@ -33,7 +33,7 @@ pub struct InterfaceEvent {
 }
 
 impl InterfaceEvent {
-    /// The event of [`PathPolarisation::interface`] (same arguments); `x` is a row's current axis,
+    /// The event of [`super::transport::PathPolarisation::interface`] (same arguments); `x` is a row's current axis,
     /// which fixes the s axis at normal incidence (where every axis is one).
     pub fn new(
         n: Vec3,

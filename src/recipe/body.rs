@@ -35,8 +35,7 @@ use crate::medium::phase::G_LIMIT;
 use crate::spectrum::measured::Measured;
 use serde::{Deserialize, Deserializer, Serialize};
 
-/// Largest coefficient (per object unit) a recipe may give.
-pub const SIGMA_MAX: f32 = 1e4;
+pub use super::spectrum::SIGMA_MAX;
 /// IOR range of a body.
 pub const BODY_IOR: (f32, f32) = (1.0001, 4.0);
 

@@ -28,14 +28,14 @@ fn sigma(c: &ColorDesc, name: &str, distance: f32) -> Result<Sigma, String> {
             .iter()
             .map(|&(l, v)| (l, -v.ln() / distance))
             .collect();
-        if points.iter().any(|p| !(p.1 <= super::body::SIGMA_MAX)) {
+        if points.iter().any(|p| !(p.1 <= super::spectrum::SIGMA_MAX)) {
             return Err(at(format!(
                 "each value must keep at least exp(−{} × distance) (0 keeps none at any \
                  distance): allowed 0 <..= 1",
-                super::body::SIGMA_MAX
+                super::spectrum::SIGMA_MAX
             )));
         }
-        let m = Measured::from_points(&points, super::body::SIGMA_MAX)
+        let m = Measured::from_points(&points, super::spectrum::SIGMA_MAX)
             .map_err(at)?
             .intern();
         return Ok((m.to_rgb(), Some(m)));

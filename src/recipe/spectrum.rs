@@ -32,6 +32,9 @@ use std::fmt;
 use std::io::Read;
 use std::path::{Path, PathBuf};
 
+/// Largest coefficient (per object unit) a recipe may give.
+pub const SIGMA_MAX: f32 = 1e4;
+
 /// Largest CSV file a recipe may name, bytes.
 pub const MAX_FILE_BYTES: u64 = 1 << 20;
 /// Largest `scale` a spectrum may be given.

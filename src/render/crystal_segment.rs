@@ -71,10 +71,11 @@ pub(super) fn take_wave(
 /// carries, the camera ray travelling along `dir` (unit). Uniaxial: `exp(−σ t)` with `σ = σ_ω`
 /// for the ordinary wave and `σ_ω cos² θ + σ_ε sin² θ` for the extraordinary, `θ` between its
 /// wave normal and the axis; biaxial: `σ = Σ (D̂·aᵢ)² σᵢ` over the principal axes, `D̂` the
-/// wave's unit displacement ([`crate::polarisation::optics::Optics::absorption_weights`]). A
-/// segment that has no wave yet (after a depolarising vertex) takes one, each with probability ½
-/// and weight 1 (the unpolarised row is the mean of the two orthogonal waves'), with
-/// `u ∈ [0, 1)`.
+/// wave's unit displacement ([`crate::polarisation::optics::Optics::absorption_weights`]),
+/// each principal coefficient's spectrum where the recipe gave one ([`absorption`]). A segment
+/// that has no wave yet takes one with `u ∈ [0, 1)`: after a depolarising vertex each with
+/// probability ½ and weight 1 (the unpolarised row is the mean of the two orthogonal waves'),
+/// after a platelet's conductor by the row it carries ([`take_wave`]).
 ///
 /// A thin section ([`CrystalOptics::thin_nm`]) is [`thin_section`] instead. The Stokes AOVs'
 /// `rows` follow.
