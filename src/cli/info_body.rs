@@ -44,8 +44,19 @@ pub(super) fn summary(b: &Body) -> String {
                 }
                 let parts: Vec<String> = names
                     .iter()
-                    .zip(&c.sigma)
-                    .map(|(n, s)| format!("σ{n} {:.3?}", s.0))
+                    .zip(c.sigma.iter().zip(&c.sigma_measured))
+                    .map(|(n, (s, m))| match m {
+                        None => format!("σ{n} {:.3?}", s.0),
+                        Some(m) => format!(
+                            "σ{n} measured, {:.3}–{:.3} (RGB {:.3?})",
+                            (360..=830)
+                                .step_by(10)
+                                .map(|l| m.at(l as f32))
+                                .fold(f32::MAX, f32::min),
+                            m.max(),
+                            s.0
+                        ),
+                    })
                     .collect();
                 format!("; pleochroic {} per object unit", parts.join(", "))
             };
