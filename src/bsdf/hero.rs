@@ -143,11 +143,7 @@ impl Scatter<HeroSample> for Bsdf {
 
     fn interface_eta(&self, channel: usize, lambda: &HeroWavelengths) -> Option<f32> {
         match self {
-            Bsdf::SmoothDielectric(_) if !(lambda.pdf[channel] > 0.0) => None,
-            Bsdf::SmoothDielectric(b) => Some(match b.dispersion {
-                None => b.eta,
-                Some(law) => law.eta_at(lambda.lambda[channel]),
-            }),
+            Bsdf::SmoothDielectric(b) => eta_at(b.eta, b.dispersion, channel, lambda),
             _ => None,
         }
     }
@@ -168,15 +164,22 @@ impl Scatter<HeroSample> for Bsdf {
     }
     fn rough_interface_eta(&self, channel: usize, lambda: &HeroWavelengths) -> Option<f32> {
         match self {
-            Bsdf::Dielectric(_) if !(lambda.pdf[channel] > 0.0) => None,
             // The wavelength's own index, as `rough_dispersive` evaluates the interface.
-            Bsdf::Dielectric(b) => Some(match b.dispersion {
-                None => b.eta,
-                Some(law) => law.eta_at(lambda.lambda[channel]),
-            }),
+            Bsdf::Dielectric(b) => eta_at(b.eta, b.dispersion, channel, lambda),
             _ => None,
         }
     }
+}
+
+/// A dielectric interface's relative index `eta` at channel `channel`'s wavelength (its `law`'s
+/// value there, if dispersive); `None` for a channel the path no longer carries.
+fn eta_at(
+    eta: f32,
+    law: Option<Dispersion>,
+    channel: usize,
+    lambda: &HeroWavelengths,
+) -> Option<f32> {
+    (lambda.pdf[channel] > 0.0).then(|| law.map_or(eta, |l| l.eta_at(lambda.lambda[channel])))
 }
 
 /// The value at the wavelengths of a coated stack whose diffuse base has a measured reflectance.

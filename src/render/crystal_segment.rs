@@ -17,10 +17,10 @@ use num_complex::Complex64 as C;
 
 /// Inside a crystal, a polarised camera row `pol` that carries no wave (after a platelet's
 /// reflection) takes one of the crystal's two waves along the unit `ray` (the camera path's
-/// direction), and the Stokes AOVs' `rows` with it; returns the factor of each channel's
-/// throughput. The light along the ray is the incoherent sum of the two waves, `Σₘ Lₘ (1, sₘ)`
-/// with `sₘ` wave `m`'s pure linear state (the two opposite: their fields are orthogonal), which
-/// the row reads as `Σₘ Lₘ (1 + w·sₘ)`. The path takes wave `m` with probability
+/// direction), and the Stokes AOVs' `rows` with it; returns the wave and the factor of each
+/// channel's throughput. The light along the ray is the incoherent sum of the two waves,
+/// `Σₘ Lₘ (1, sₘ)` with `sₘ` wave `m`'s pure linear state (the two opposite: their fields are
+/// orthogonal), which the row reads as `Σₘ Lₘ (1 + w·sₘ)`. The path takes wave `m` with probability
 /// `(1 + w·sₘ) / 2` of channel 0's ratios (½ each for an unpolarised row) and carries its pure
 /// row, which reads `2 Lₘ`: weight 1 for channel 0, `(1 + w_c·sₘ) / (1 + w₀·sₘ)` for channel
 /// `c`, and each AOV row's factor changes by its reading over the sensor's. `u ∈ [0, 1)`.
@@ -30,41 +30,45 @@ pub(super) fn take_wave(
     rows: Option<&mut StokesRows>,
     ray: glam::DVec3,
     u: f64,
-) -> [f32; MAX_CHANNELS] {
+) -> TakenWave {
     let modes = optics.modes();
-    let light = (-ray).as_vec3();
-    let field = optics.field(ray, modes[0]).as_vec3();
-    // Each channel's reading of wave m's pure state: the row turned to the first wave's field
-    // (S1 there is the first wave's state, its negative the second's).
-    let reading = |p: &PathPolarisation, m: Mode| -> [f32; MAX_CHANNELS] {
+    let (light, field) = ((-ray).as_vec3(), optics.field(ray, modes[0]).as_vec3());
+    // Each channel's S1 ratio in the first wave's field frame: the first wave's state reads
+    // `1 + S1`, the second's `1 − S1`.
+    let s1 = |p: &PathPolarisation| -> [f32; MAX_CHANNELS] {
         let mut q = *p;
         q.rotate_to(field, light);
-        let sign = if m == modes[0] { 1.0 } else { -1.0 };
-        std::array::from_fn(|c| (1.0 + sign * q.w[c][0]).max(0.0))
+        q.w.map(|w| w[0])
     };
-    let mode = if u < 0.5 * f64::from(reading(pol, modes[0])[0]) {
-        modes[0]
+    let sensor_s1 = s1(pol);
+    let first = f64::from(1.0 + sensor_s1[0]);
+    let (mode, sign) = if u < 0.5 * first {
+        (modes[0], 1.0)
     } else {
-        modes[1]
+        (modes[1], -1.0)
     };
-    let sensor = reading(pol, mode);
+    let reading = |s1: [f32; MAX_CHANNELS]| s1.map(|v| (1.0 + sign * v).max(0.0));
+    let sensor = reading(sensor_s1);
     if let Some(r) = rows
         && !r.settled
     {
         for j in 0..ROWS {
-            let own = reading(&r.rows[j], mode);
+            let own = reading(s1(&r.rows[j]));
             r.rescale(j, own, sensor);
         }
     }
-    let k = std::array::from_fn(|c| {
-        if sensor[0] > 0.0 {
-            sensor[c] / sensor[0]
-        } else {
-            0.0
-        }
-    });
+    let channels = sensor.map(|v| if sensor[0] > 0.0 { v / sensor[0] } else { 0.0 });
     *pol = crystal::pure_state(optics, ray, mode);
-    k
+    TakenWave { mode, channels }
+}
+
+/// The wave a row took ([`take_wave`]) and the factor of each channel's throughput.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct TakenWave {
+    /// The crystal's wave.
+    pub mode: Mode,
+    /// Per channel, the factor of its throughput.
+    pub channels: [f32; MAX_CHANNELS],
 }
 
 /// The transmittance over distance `t` of a pleochroic crystal for the wave the path's segment
@@ -112,9 +116,9 @@ pub(super) fn pleochroic_transmittance<S: Spectral>(
             m
         }
         None => {
-            let r = rows.as_deref_mut();
-            channels = Some(take_wave(&optics, pol, r, ray, f64::from(u)));
-            pol.mode.unwrap_or(modes[0])
+            let taken = take_wave(&optics, pol, rows.as_deref_mut(), ray, f64::from(u));
+            channels = Some(taken.channels);
+            taken.mode
         }
     };
     // The principal coefficients' shares.

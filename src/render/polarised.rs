@@ -162,7 +162,7 @@ pub(super) fn polarise<S: Spectral>(
 pub(super) fn crystal_sample<S: Spectral>(
     crystal: &CrystalOptics,
     pol: &mut PathPolarisation,
-    rows: Option<&mut StokesRows>,
+    mut rows: Option<&mut StokesRows>,
     sb: &SurfaceBsdf<'_>,
     wo: Vec3,
     outside: bool,
@@ -192,9 +192,8 @@ where
         normal,
     };
     // Inside, a polarised row without a wave (after a platelet) takes one first.
-    let mut rows = rows;
     let channels = (!outside && pol.mode.is_none() && !pol.is_unpolarised())
-        .then(|| take_wave(&b.crystal, pol, rows.as_deref_mut(), -wo, f64::from(u.0)));
+        .then(|| take_wave(&b.crystal, pol, rows.as_deref_mut(), -wo, f64::from(u.0)).channels);
     let step = if outside {
         crystal::from_outside(&b, wo, pol, f64::from(u.0))?
     } else {
