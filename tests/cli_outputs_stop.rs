@@ -93,12 +93,18 @@ fn ctrl_c_before_the_first_pass_writes_nothing() {
 #[cfg(unix)]
 #[test]
 fn a_second_signal_aborts_without_writing() {
-    // Both are delivered together when the stopped process continues, so the second arrives
-    // before the first can have ended the run, wherever it was: the second aborts at once.
+    // Both are delivered together when the stopped process continues. The handler thread reads
+    // them one at a time: usually the second arrives while the first is still ending the run and
+    // aborts it at once, but on a loaded machine the run can end on the first alone before the
+    // thread has read the second. Either way the run exits 130 and writes nothing; only the
+    // message says which signal ended it, so the test accepts either (CI once saw the first end
+    // it). The abort itself cannot be held apart from the first stop here: a recipe that could
+    // block the run (a FIFO) is refused before it is opened.
+    // Both messages end with "nothing written".
     stopped_before_the_first_pass(
         "twice",
         &["-STOP", "-INT", "-TERM", "-CONT"],
-        &["second interrupt: aborted, nothing written"],
+        &["nothing written"],
     );
 }
 
