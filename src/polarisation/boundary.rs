@@ -18,7 +18,7 @@
 //! conservation for random crystals, axes and directions, reciprocity, and a biaxial crystal with
 //! two equal indices against the uniaxial closed forms.
 
-use super::cvec::{CVec, add, cross, cv, dot, norm, real, scale, solve4};
+use super::cvec::{CVec, add, cross, cv, dot, is_real, norm, real, scale, solve4, solve4_real};
 pub use super::optics::Mode;
 use super::optics::Optics;
 use glam::DVec3;
@@ -38,17 +38,29 @@ pub struct Wave {
 }
 
 impl Wave {
+    #[inline(always)]
     pub(super) fn new(mode: Mode, k: CVec, e: CVec) -> Wave {
-        Wave {
-            mode,
-            k,
-            e,
-            h: cross(k, e),
-        }
+        // A propagating wave's product in real arithmetic: the complex product's operations on
+        // numbers whose imaginary parts are zero, the same real parts bit for bit.
+        let h = if is_real(k) && is_real(e) {
+            cv(real(k).cross(real(e)))
+        } else {
+            cross(k, e)
+        };
+        Wave { mode, k, e, h }
+    }
+
+    /// Whether its fields are real (a propagating wave's; then so is its wave vector).
+    #[inline(always)]
+    fn is_real(&self) -> bool {
+        is_real(self.e) && is_real(self.h)
     }
 
     /// Power flux of unit amplitude through the boundary along the unit `n`.
     pub fn flux(&self, n: DVec3) -> f64 {
+        if self.is_real() {
+            return real(self.e).cross(real(self.h)).dot(n);
+        }
         let s = cross(self.e, self.h.map(|c| c.conj()));
         real(s).dot(n)
     }
@@ -268,27 +280,49 @@ impl Boundary {
         });
         // Tangential E and H continuous: Σ(isotropic side) = Σ(crystal side). Unknowns: the four
         // outgoing amplitudes; the incident wave sits on its own side.
-        let t1 = cv(s);
-        let t2 = cv(n.cross(s));
-        let rows = |w: &Wave| [dot(w.e, t1), dot(w.e, t2), dot(w.h, t1), dot(w.h, t2)];
-        let mut a = [[C::from(0.0); 4]; 4];
-        for (j, w) in out.iter().enumerate() {
-            let sign = if j < 2 { 1.0 } else { -1.0 };
-            for (i, v) in rows(w).into_iter().enumerate() {
-                a[i][j] = v * sign;
-            }
-        }
-        let mut b = [[C::from(0.0); R]; 4];
-        for (k, (incident, w)) in incidents.iter().zip(&inc).enumerate() {
-            let inc_sign = match incident {
-                Incident::Outside { .. } => -1.0,
-                Incident::Inside { .. } => 1.0,
+        let t2 = n.cross(s);
+        let out_sign = |j: usize| if j < 2 { 1.0 } else { -1.0 };
+        let inc_sign = |incident: &Incident| match incident {
+            Incident::Outside { .. } => -1.0,
+            Incident::Inside { .. } => 1.0,
+        };
+        let x = if out.iter().chain(&inc).all(Wave::is_real) {
+            // Every wave propagating: the complex rows' and elimination's operations on numbers
+            // whose imaginary parts are zero, in real arithmetic (the same numbers bit for bit).
+            let rows = |w: &Wave| {
+                let (e, h) = (real(w.e), real(w.h));
+                [e.dot(s), e.dot(t2), h.dot(s), h.dot(t2)]
             };
-            for (i, v) in rows(w).into_iter().enumerate() {
-                b[i][k] = v * inc_sign;
+            let mut a = [[0.0; 4]; 4];
+            for (j, w) in out.iter().enumerate() {
+                for (i, v) in rows(w).into_iter().enumerate() {
+                    a[i][j] = v * out_sign(j);
+                }
             }
-        }
-        let x = solve4(a, b)?;
+            let mut b = [[0.0; R]; 4];
+            for (k, (incident, w)) in incidents.iter().zip(&inc).enumerate() {
+                for (i, v) in rows(w).into_iter().enumerate() {
+                    b[i][k] = v * inc_sign(incident);
+                }
+            }
+            solve4_real(a, b)?.map(|xk| xk.map(C::from))
+        } else {
+            let (t1, t2) = (cv(s), cv(t2));
+            let rows = |w: &Wave| [dot(w.e, t1), dot(w.e, t2), dot(w.h, t1), dot(w.h, t2)];
+            let mut a = [[C::from(0.0); 4]; 4];
+            for (j, w) in out.iter().enumerate() {
+                for (i, v) in rows(w).into_iter().enumerate() {
+                    a[i][j] = v * out_sign(j);
+                }
+            }
+            let mut b = [[C::from(0.0); R]; 4];
+            for (k, (incident, w)) in incidents.iter().zip(&inc).enumerate() {
+                for (i, v) in rows(w).into_iter().enumerate() {
+                    b[i][k] = v * inc_sign(incident);
+                }
+            }
+            solve4(a, b)?
+        };
         let flux_in = inc.map(|w| w.flux(n).abs());
         if !flux_in.iter().all(|f| *f > 0.0) {
             return None;

@@ -42,6 +42,11 @@ pub fn norm(a: CVec) -> f64 {
     a.iter().map(|c| c.norm_sqr()).sum::<f64>().sqrt()
 }
 
+/// Whether every imaginary part is zero.
+pub fn is_real(a: CVec) -> bool {
+    a.iter().all(|c| c.im == 0.0)
+}
+
 /// The real part.
 pub fn real(a: CVec) -> DVec3 {
     DVec3::new(a[0].re, a[1].re, a[2].re)
@@ -93,7 +98,7 @@ pub fn solve4<const R: usize>(mut a: [[C; 4]; 4], mut b: [[C; R]; 4]) -> Option<
 /// real arithmetic with the complex path's operations on numbers whose imaginary parts are zero:
 /// a quotient `a / c` as `(a c) / (c c)`, as the complex division forms it, so the solution is
 /// the complex path's bit for bit (tested).
-fn solve4_real<const R: usize>(
+pub fn solve4_real<const R: usize>(
     mut a: [[f64; 4]; 4],
     mut b: [[f64; R]; 4],
 ) -> Option<[[f64; 4]; R]> {
