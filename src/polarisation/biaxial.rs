@@ -17,7 +17,6 @@
 //! `∇F`, equal to the Poynting vector `E × (k × E)`.
 
 use super::cvec::{CVec, cross as ccross, cv as complex, dot as cdot, norm as cnorm, real};
-use super::quartic;
 use glam::DVec3;
 use num_complex::Complex64 as C;
 
@@ -38,7 +37,7 @@ fn along(axes: &[DVec3; 3], v: CVec) -> CVec {
 
 impl Biaxial {
     /// The principal permittivities `n_i²`.
-    fn eps(&self) -> [f64; 3] {
+    pub(super) fn eps(&self) -> [f64; 3] {
         self.n.map(|n| n * n)
     }
 
@@ -167,13 +166,17 @@ impl Biaxial {
         }
         let rows = self.rows(k);
         let scale = self.n.iter().fold(0.0f64, |m, v| m.max(v * v)).powi(2);
+        // The largest by its squared length (one square root, for the one kept).
+        let norm2 = |v: &CVec| v.iter().map(|c| c.norm_sqr()).sum::<f64>();
         let mut best = ccross(rows[0], rows[1]);
+        let mut best2 = norm2(&best);
         for cand in [ccross(rows[1], rows[2]), ccross(rows[2], rows[0])] {
-            if cnorm(cand) > cnorm(best) {
-                best = cand;
+            let cand2 = norm2(&cand);
+            if cand2 > best2 {
+                (best, best2) = (cand, cand2);
             }
         }
-        let nb = cnorm(best);
+        let nb = best2.sqrt();
         if nb > 1e-7 * scale {
             best.map(|c| c / nb)
         } else {
@@ -199,15 +202,18 @@ impl Biaxial {
             }
             DVec3::from_array(r)
         });
-        // glam's cross and length form the same products and sums as the complex path's.
+        // glam's cross and squared length form the same products and sums as the complex
+        // path's.
         let scale = self.n.iter().fold(0.0f64, |m, v| m.max(v * v)).powi(2);
         let mut best = rows[0].cross(rows[1]);
+        let mut best2 = best.length_squared();
         for cand in [rows[1].cross(rows[2]), rows[2].cross(rows[0])] {
-            if cand.length() > best.length() {
-                best = cand;
+            let cand2 = cand.length_squared();
+            if cand2 > best2 {
+                (best, best2) = (cand, cand2);
             }
         }
-        let nb = best.length();
+        let nb = best2.sqrt();
         (nb > 1e-7 * scale).then(|| best / nb)
     }
 
@@ -241,74 +247,6 @@ impl Biaxial {
             .map(|i| eps[i] * self.axes[i].dot(e) * self.axes[i])
             .sum();
         d.normalize_or_zero()
-    }
-
-    /// The normal components `u` of the four waves `k = t + u m` with tangential wave vector `t`
-    /// on a boundary with unit normal `m` (`t · m = 0`): the roots of the quartic `F(t + u m)`.
-    pub fn normal_components(&self, t: DVec3, m: DVec3) -> Option<[C; 4]> {
-        let e = self.eps();
-        let tr = e[0] + e[1] + e[2];
-        let tc = self.axes.map(|a| a.dot(t));
-        let mc = self.axes.map(|a| a.dot(m));
-        // kᵀεk = a0 + a1 u + a2 u², kᵀ(tr ε ε − ε²)k = b0 + b1 u + b2 u².
-        let (mut a, mut b) = ([0.0; 3], [0.0; 3]);
-        for i in 0..3 {
-            let w = [e[i], e[i] * (tr - e[i])];
-            for (f, wi) in [(&mut a, w[0]), (&mut b, w[1])] {
-                f[0] += wi * tc[i] * tc[i];
-                f[1] += 2.0 * wi * tc[i] * mc[i];
-                f[2] += wi * mc[i] * mc[i];
-            }
-        }
-        let tt = t.length_squared();
-        let det = e[0] * e[1] * e[2];
-        // (tt + u²)(a0 + a1 u + a2 u²) − (b0 + b1 u + b2 u²) + det.
-        let c4 = a[2];
-        if !(c4 > 0.0) {
-            return None;
-        }
-        let c = [
-            (tt * a[0] - b[0] + det) / c4,
-            (tt * a[1] - b[1]) / c4,
-            (a[0] + tt * a[2] - b[2]) / c4,
-            a[1] / c4,
-        ];
-        // Start from each sheet's index along the wave an isotropic medium of index n_β would
-        // carry, up and down (imaginary when evanescent): within about Δn × walk-off of the
-        // roots. Durand–Kerner's starts (where the factor does not settle: near grazing, where
-        // up and down waves meet) are tilted off the real axis so that no two coincide.
-        let q = |n: f64| C::from(n * n - tt).sqrt();
-        let qb = q(self.n[1]).re;
-        let guess = |up: bool| -> [C; 2] {
-            let d = t + if up { qb } else { -qb } * m;
-            let sheets = d.try_normalize().map_or(self.n, |d| {
-                let [f, s] = self.indices(d);
-                [f, s, 0.0]
-            });
-            let sign = if up { 1.0 } else { -1.0 };
-            [sign * q(sheets[0]), sign * q(sheets[1])]
-        };
-        let ([uf, us], [df, ds]) = (guess(true), guess(false));
-        // A real quadratic factor to start Bairstow's method from: the two up waves when both
-        // propagate, else an evanescent sheet's decaying and growing pair (conjugates).
-        let pair = |a: C, b: C| (-(a + b).re, (a * b).re);
-        let (r, s) = if uf.im == 0.0 && us.im == 0.0 {
-            pair(uf, us)
-        } else if uf.im != 0.0 {
-            pair(uf, df)
-        } else {
-            pair(us, ds)
-        };
-        if let Some(u) = quartic::factored(c, r, s) {
-            return Some(u);
-        }
-        let start = [
-            uf * C::new(1.0, 1e-3),
-            df * C::new(1.0, 2e-3),
-            us * C::new(1.0, -1e-3) + C::new(1e-4, 0.0),
-            ds * C::new(1.0, -2e-3) - C::new(1e-4, 0.0),
-        ];
-        quartic::roots(c, Some(start))
     }
 }
 
@@ -481,7 +419,7 @@ pub(super) mod tests {
             };
             let m = random_unit(&mut rng);
             let t = 1.3 * f64::from(rng.uniform()) * m.any_orthonormal_vector();
-            let roots = b.normal_components(t, m).unwrap();
+            let roots = b.normal_components(t, m).unwrap().u;
             for u in roots {
                 let k = [0, 1, 2].map(|i| C::from(t.to_array()[i]) + u * m.to_array()[i]);
                 let (a, bb, c) = b.forms(along(&b.axes, k));
@@ -491,7 +429,7 @@ pub(super) mod tests {
             // |t| < n_α: all four waves propagate.
             assert!(roots.iter().all(|u| u.im.abs() < 1e-9), "{roots:?}");
             // The reversed problem's roots are these negated (F is even in k).
-            let back = b.normal_components(-t, m).unwrap();
+            let back = b.normal_components(-t, m).unwrap().u;
             for u in roots {
                 assert!(back.iter().any(|v| (*v + u).norm() < 1e-10), "{u} {back:?}");
             }

@@ -244,7 +244,7 @@ impl Boundary {
             ],
             Optics::Biaxial(x) => {
                 let u = x.normal_components(t, self.normal)?;
-                self.biaxial_down(x, t, s, u)?
+                self.biaxial_down(x, t, s, &u)?
             }
         };
         Some([
