@@ -18,7 +18,7 @@
 //! conservation for random crystals, axes and directions, reciprocity, and a biaxial crystal with
 //! two equal indices against the uniaxial closed forms.
 
-use super::cvec::{CVec, add, cross, cv, dot, is_real, norm, real, scale, solve4, solve4_real};
+use super::cvec::{CVec, add, cross, cv, dot, is_real, real, scale, solve4, solve4_real};
 pub use super::optics::Mode;
 use super::optics::Optics;
 use glam::DVec3;
@@ -137,65 +137,24 @@ impl Boundary {
     /// The isotropic side's wave of `mode` with tangential `t`, going away from the boundary
     /// (`up`) or toward it.
     fn isotropic(&self, t: DVec3, s: DVec3, mode: Mode, up: bool) -> Wave {
-        let q = C::from(self.n1 * self.n1 - t.length_squared()).sqrt();
+        let q2 = self.n1 * self.n1 - t.length_squared();
+        if q2 >= 0.0 {
+            // Propagating: the complex path's operations in real arithmetic (the same numbers
+            // but for the sign of a zero).
+            let q = if up { q2.sqrt() } else { -q2.sqrt() };
+            let k = t + self.normal * q;
+            let e = match mode {
+                Mode::S => s,
+                _ => k.cross(s) * (1.0 / self.n1),
+            };
+            return Wave::new(mode, cv(k), cv(e));
+        }
+        let q = C::from(q2).sqrt();
         let q = if up { q } else { -q };
         let k = add(cv(t), scale(cv(self.normal), q));
         let e = match mode {
             Mode::S => cv(s),
             _ => scale(cross(k, cv(s)), C::from(1.0 / self.n1)),
-        };
-        Wave::new(mode, k, e)
-    }
-
-    /// The crystal's wave of `mode` with tangential `t`, going away from the boundary (down,
-    /// decaying into the crystal when evanescent) or toward it (`up`, propagating).
-    fn crystal_wave(
-        &self,
-        x: &super::uniaxial::Uniaxial,
-        t: DVec3,
-        mode: Mode,
-        up: bool,
-        s: DVec3,
-    ) -> Wave {
-        let (n, c) = (self.normal, x.axis);
-        let (io, ie) = (1.0 / (x.no * x.no), 1.0 / (x.ne * x.ne));
-        // The normal component u of k = t + u n.
-        let u = match mode {
-            Mode::O => {
-                let q = C::from(x.no * x.no - t.length_squared()).sqrt();
-                if up { q } else { -q }
-            }
-            _ => {
-                // (a + u b)² io + (|t|² + u² − (a + u b)²) ie = 1; the root with `+√` carries
-                // energy along +n (the index surface's normal has n-component u·qa + qb/2).
-                let (a, b) = (t.dot(c), n.dot(c));
-                let qa = b * b * (io - ie) + ie;
-                let qb = 2.0 * a * b * (io - ie);
-                let qc = a * a * (io - ie) + t.length_squared() * ie - 1.0;
-                let root = C::from(qb * qb - 4.0 * qa * qc).sqrt();
-                let root = if up { root } else { -root };
-                (root - qb) / (2.0 * qa)
-            }
-        };
-        let k = add(cv(t), scale(cv(n), u));
-        let cc = cv(c);
-        let kc = cross(k, cc);
-        // Along the axis both waves are ordinary: take the s direction for one and the field
-        // across it for the other.
-        let degenerate = norm(kc) <= 1e-9 * norm(k);
-        let e = match mode {
-            Mode::O if degenerate => cv(s),
-            Mode::O => scale(kc, C::from(1.0 / norm(kc))),
-            _ => {
-                let d = if degenerate {
-                    cross(k, cv(s))
-                } else {
-                    // D ⟂ k in the plane of k and c; E = ε⁻¹ D.
-                    add(scale(cc, dot(k, k)), scale(k, -dot(k, cc)))
-                };
-                let e = add(scale(d, C::from(io)), scale(cc, dot(cc, d) * (ie - io)));
-                scale(e, C::from(1.0 / norm(e).max(f64::MIN_POSITIVE)))
-            }
         };
         Wave::new(mode, k, e)
     }

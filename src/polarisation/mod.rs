@@ -37,6 +37,7 @@ pub mod quartic;
 pub mod stokes;
 pub mod transport;
 pub mod uniaxial;
+mod uniaxial_boundary;
 
 pub use mueller::Mueller;
 
