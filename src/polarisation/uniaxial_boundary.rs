@@ -26,14 +26,7 @@ impl Boundary {
     }
 
     /// [`Boundary::crystal_wave`] in complex arithmetic (any wave, evanescent ones too).
-    fn crystal_wave_complex(
-        &self,
-        x: &Uniaxial,
-        t: DVec3,
-        mode: Mode,
-        up: bool,
-        s: DVec3,
-    ) -> Wave {
+    fn crystal_wave_complex(&self, x: &Uniaxial, t: DVec3, mode: Mode, up: bool, s: DVec3) -> Wave {
         let (n, c) = (self.normal, x.axis);
         let (io, ie) = (1.0 / (x.no * x.no), 1.0 / (x.ne * x.ne));
         // The normal component u of k = t + u n.
