@@ -25,6 +25,20 @@ impl Boundary {
             .unwrap_or_else(|| self.crystal_wave_complex(x, t, mode, up, s))
     }
 
+    /// The quadratic `qa u² + qb u + qc = 0` of the extraordinary wave's normal component `u`
+    /// (`k = t + u n`): `(a + u b)² / n_o² + (|t|² + u² − (a + u b)²) / n_e² = 1` with `a = t·c`,
+    /// `b = n·c`; the root with `+√` carries energy along `+n` (the index surface's normal has
+    /// n-component `u·qa + qb/2`).
+    fn extraordinary_quadratic(&self, x: &Uniaxial, t: DVec3) -> [f64; 3] {
+        let (io, ie) = (1.0 / (x.no * x.no), 1.0 / (x.ne * x.ne));
+        let (a, b) = (t.dot(x.axis), self.normal.dot(x.axis));
+        [
+            b * b * (io - ie) + ie,
+            2.0 * a * b * (io - ie),
+            a * a * (io - ie) + t.length_squared() * ie - 1.0,
+        ]
+    }
+
     /// [`Boundary::crystal_wave`] in complex arithmetic (any wave, evanescent ones too).
     fn crystal_wave_complex(&self, x: &Uniaxial, t: DVec3, mode: Mode, up: bool, s: DVec3) -> Wave {
         let (n, c) = (self.normal, x.axis);
@@ -36,12 +50,7 @@ impl Boundary {
                 if up { q } else { -q }
             }
             _ => {
-                // (a + u b)² io + (|t|² + u² − (a + u b)²) ie = 1; the root with `+√` carries
-                // energy along +n (the index surface's normal has n-component u·qa + qb/2).
-                let (a, b) = (t.dot(c), n.dot(c));
-                let qa = b * b * (io - ie) + ie;
-                let qb = 2.0 * a * b * (io - ie);
-                let qc = a * a * (io - ie) + t.length_squared() * ie - 1.0;
+                let [qa, qb, qc] = self.extraordinary_quadratic(x, t);
                 let root = C::from(qb * qb - 4.0 * qa * qc).sqrt();
                 let root = if up { root } else { -root };
                 (root - qb) / (2.0 * qa)
@@ -93,10 +102,7 @@ impl Boundary {
                 if up { q2.sqrt() } else { -q2.sqrt() }
             }
             _ => {
-                let (a, b) = (t.dot(c), n.dot(c));
-                let qa = b * b * (io - ie) + ie;
-                let qb = 2.0 * a * b * (io - ie);
-                let qc = a * a * (io - ie) + t.length_squared() * ie - 1.0;
+                let [qa, qb, qc] = self.extraordinary_quadratic(x, t);
                 let disc = qb * qb - 4.0 * qa * qc;
                 if !(disc >= 0.0) {
                     return None;
