@@ -41,6 +41,7 @@ pub mod oren_nayar;
 pub mod record;
 pub mod smooth_dielectric;
 pub mod spectral;
+pub mod store;
 pub mod table;
 pub mod torrance_sparrow;
 

@@ -74,11 +74,11 @@ impl TorranceSparrow {
         let key = (d.kind(), d.masking(), d.alpha().to_bits());
         let e_ss = E_SS.get_or_build(key, || {
             let plain = TorranceSparrow::new(d, Fresnel::Perfect);
-            Arc::new(Table::by_sampling(
-                32,
-                hash_words(&[0xc0_4e05]),
-                |wo, uc, u| plain.sample_weight(wo, uc, u),
-            ))
+            Arc::new(crate::bsdf::store::table("e_ss", &(d, 32), || {
+                Table::by_sampling(32, hash_words(&[0xc0_4e05]), |wo, uc, u| {
+                    plain.sample_weight(wo, uc, u)
+                })
+            }))
         });
         self.compensation = Some(Compensation {
             e_ss,

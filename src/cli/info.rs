@@ -391,6 +391,33 @@ pub fn describe(recipe: &GemRecipe, scene: &Scene, points: u32) -> String {
         }
     );
 
+    // Where the material tables come from (crate::bsdf::store).
+    let _ = writeln!(
+        o,
+        "material tables: {}",
+        match crate::bsdf::store::global() {
+            Some(store) => format!(
+                "kept between runs in {} ({} files{}; {}=off measures them every run)",
+                store.dir().display(),
+                std::fs::read_dir(store.dir()).map_or(0, |d| d.count()),
+                if store.full() {
+                    format!(
+                        ", full: at most {} are kept, new tables are measured every run until \
+                         the folder is removed",
+                        crate::bsdf::store::MAX_FILES
+                    )
+                } else {
+                    String::new()
+                },
+                crate::bsdf::store::ENV
+            ),
+            None => format!(
+                "measured every run (no table cache: {} is off or no cache folder is known)",
+                crate::bsdf::store::ENV
+            ),
+        }
+    );
+
     // Effects.
     let _ = writeln!(o, "\neffects:");
     for e in Effect::ALL {

@@ -457,6 +457,15 @@ fn summary(
         s.rays as f64 / secs / 1e6,
         grouped(s.dropped)
     );
+    if let Some(store) = crate::bsdf::store::global() {
+        let (read, measured) = store.counts();
+        if read + measured > 0 {
+            out += &format!(
+                "  material tables: {measured} measured, {read} read back ({})\n",
+                store.dir().display()
+            );
+        }
+    }
     let effects: Vec<&str> = scene.effects.iter().map(Effect::name).collect();
     out += &format!(
         "  effects: {}\n",

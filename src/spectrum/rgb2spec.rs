@@ -46,7 +46,7 @@
 use super::cie::{self, CMF_SAMPLES, LAMBDA_MIN};
 use std::sync::OnceLock;
 
-mod cache;
+pub(crate) mod cache;
 pub mod fit;
 mod sigmoid;
 

@@ -110,7 +110,10 @@ impl RoughDielectric {
                 },
             )
         };
-        InterfaceEnergy::new(table(1.0), table(-1.0), self.eta).map(Arc::new)
+        let key = (self.distribution, self.eta, grid);
+        let [above, below] =
+            crate::bsdf::store::tables("interface energy", &key, || [table(1.0), table(-1.0)]);
+        InterfaceEnergy::new(above, below, self.eta).map(Arc::new)
     }
 
     /// Probability that a sample from `wo` with `lobes` allowed is drawn from the

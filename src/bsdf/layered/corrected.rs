@@ -379,36 +379,24 @@ pub(super) fn build_tables(stack: &mut LayeredBsdf, l: usize, grid: usize) {
             (l, grid),
         );
         let table = E_TOP.get_or_build(key, || {
-            Arc::new(
+            Arc::new(crate::bsdf::store::table("e_top", &key, || {
                 Table::by_sampling(grid, hash_words(&[l as u64, 1]), |wo, uc, u| {
                     top.sample_weight(wo, uc, u).map(|w| w.min(1e3))
                 })
-                .map(|e| e.min(1.0)),
-            )
+                .map(|e| e.min(1.0))
+            }))
         });
         Table::clone(&table)
     };
 
     let (eta, od) = (stack.levels[l].eta, stack.levels[l].od);
     let this = &*stack;
-    let (albedo_rest, trapped) = Table::build_pair_par(|mu| {
-        let wo_in = Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
-        let (mut a, mut q) = (RgbSample::ZERO, RgbSample::ZERO);
-        for_strata(
-            grid,
-            hash_words(&[l as u64, 2, u64::from(mu.to_bits())]),
-            |uc, u| {
-                if let Some(s) = sample(this, l + 1, wo_in, uc, u, true) {
-                    let wa = s.weight * absorption(od, mu, s.wi.z);
-                    let t_out =
-                        refract_macro(s.wi, 1.0 / eta).map_or(0.0, |wi| this.levels[l].t(wi.z));
-                    a += wa;
-                    q += wa * (1.0 - t_out);
-                }
-            },
-        );
-        (a / n2, q / n2)
-    });
+    // The stack's Debug text holds every input (this level's coat, the levels below it).
+    let [albedo_rest, trapped] =
+        crate::bsdf::store::tables("albedo_rest", &(l, grid, this), || {
+            let (albedo_rest, trapped) = measure_rest(this, l, grid, n2, eta, od);
+            [albedo_rest, trapped]
+        });
 
     let lv = &stack.levels[l];
     let t_table = Table::build(|mu| RgbSample::splat(lv.t(mu)));
@@ -435,6 +423,37 @@ pub(super) fn build_tables(stack: &mut LayeredBsdf, l: usize, grid: usize) {
     lv.trapped = trapped;
     lv.multi_scale = multi_scale;
     lv.multi_albedo = multi_albedo;
+}
+
+/// `A` and `Q` of level `l` (the albedo of the layers below seen through its coat's absorption,
+/// and the part of it trapped by internal reflection), by stratified Monte Carlo over the Corrected
+/// sampling of the layers below (`n2` samples per entry).
+fn measure_rest(
+    this: &LayeredBsdf,
+    l: usize,
+    grid: usize,
+    n2: f32,
+    eta: f32,
+    od: RgbSample,
+) -> (Table, Table) {
+    Table::build_pair_par(|mu| {
+        let wo_in = Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
+        let (mut a, mut q) = (RgbSample::ZERO, RgbSample::ZERO);
+        for_strata(
+            grid,
+            hash_words(&[l as u64, 2, u64::from(mu.to_bits())]),
+            |uc, u| {
+                if let Some(s) = sample(this, l + 1, wo_in, uc, u, true) {
+                    let wa = s.weight * absorption(od, mu, s.wi.z);
+                    let t_out =
+                        refract_macro(s.wi, 1.0 / eta).map_or(0.0, |wi| this.levels[l].t(wi.z));
+                    a += wa;
+                    q += wa * (1.0 - t_out);
+                }
+            },
+        );
+        (a / n2, q / n2)
+    })
 }
 
 #[cfg(test)]

@@ -464,7 +464,10 @@ impl LayeredBsdf {
             && self.calibration.is_none()
             && !self.levels.is_empty()
         {
-            self.calibration = Some(std::sync::Arc::new(calibrate::calibration(self)));
+            // Read back from the table store when an earlier run measured it (same inputs).
+            let table =
+                crate::bsdf::store::table("calibration", &*self, || calibrate::calibration(self));
+            self.calibration = Some(std::sync::Arc::new(table));
         }
         if matches!(self.model, Model::Reference(_)) && self.compensation {
             for lv in self.levels.iter_mut() {

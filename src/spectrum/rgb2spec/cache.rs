@@ -56,8 +56,9 @@ fn compute_key() -> u64 {
     fnv(&super::Z_DARK.to_bits().to_le_bytes(), h)
 }
 
-/// The cache folder, or `None` when caching is off or no folder is known.
-fn folder() -> Option<PathBuf> {
+/// The cache folder, or `None` when caching is off or no folder is known (the material tables'
+/// store, `crate::bsdf::store`, keeps its files in a `tables` folder inside it).
+pub(crate) fn folder() -> Option<PathBuf> {
     let var = |k: &str| std::env::var_os(k).filter(|v| !v.is_empty());
     if let Some(d) = var("LAPIDARY_CACHE_DIR") {
         return (d != "off").then(|| PathBuf::from(d));
