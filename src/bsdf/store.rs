@@ -28,7 +28,7 @@ use std::hash::{DefaultHasher, Hasher};
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
-use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 
 /// The environment variable that places the store's folder (`off`: no store); the same as the
 /// spectral coefficient table's cache ([`crate::spectrum::rgb2spec`]).
@@ -62,6 +62,15 @@ pub fn global() -> Option<&'static Store> {
             Some(Store::open(dir, build_identity()?))
         })
         .as_ref()
+}
+
+/// Whether the process's store reads tables back (on unless [`measure_always`] was called).
+static READ: AtomicBool = AtomicBool::new(true);
+
+/// Makes the process's store measure every table (and still keep it): for `lapidary tradeoff`,
+/// whose setup column is the cost of measuring a setting's tables.
+pub fn measure_always() {
+    READ.store(false, Ordering::Relaxed);
 }
 
 /// The tables `build` measures, read from the process's store when they are there (module docs).
@@ -141,7 +150,9 @@ impl Store {
     ) -> [Table; N] {
         let id = self.key(what, key);
         let path = self.dir.join(format!("{id:032x}.tab"));
-        if let Some(t) = read::<N>(&path, id) {
+        if READ.load(Ordering::Relaxed)
+            && let Some(t) = read::<N>(&path, id)
+        {
             self.hits.fetch_add(1, Ordering::Relaxed);
             return t;
         }

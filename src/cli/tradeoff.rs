@@ -188,6 +188,9 @@ pub fn run(args: &TradeoffArgs) -> Result<()> {
             threads,
         );
     }
+    // The setup column is the cost of measuring each setting's tables, not of reading them back
+    // from an earlier run (crate::bsdf::store).
+    crate::bsdf::store::measure_always();
     let mut rows = Vec::with_capacity(settings.len());
     for (i, (knobs, label)) in settings.iter().zip(&labels).enumerate() {
         let mut scene = base.clone();
