@@ -16,10 +16,12 @@
 //!
 //! **Safety**: the store only creates files whose names it derives from keys (`<32 hex>.tab`),
 //! writes each to a fresh temporary file of its own first (`create_new`: it never opens a file it
-//! did not make) and renames it into place, and never deletes anything but its own temporary file
-//! after a failed write. It is bounded: past [`MAX_FILES`] files in the folder it stops writing
-//! (`lapidary info` says so; removing the folder starts it afresh); a full disk or a read-only
-//! folder only means the tables are measured. Failures are silent: the store only saves time.
+//! did not make for writing) and renames it into place, and never deletes anything but its own
+//! temporary file
+//! after a failed write or its own oldest table files when the folder reaches [`MAX_FILES`]
+//! (those whose name is a key's and whose contents start with the store's magic; down to three
+//! quarters of the bound). A full disk or a read-only folder only means the tables are measured.
+//! Failures are silent: the store only saves time.
 
 use super::table::{ENTRIES, Table};
 use crate::spectrum::RgbSample;
@@ -34,7 +36,8 @@ use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 /// spectral coefficient table's cache ([`crate::spectrum::rgb2spec`]).
 pub const ENV: &str = "LAPIDARY_CACHE_DIR";
 
-/// Most files the store lets its folder hold before it stops writing (a file is ~1–3 KB).
+/// Most files the store lets its folder hold (a file is ~1–3 KB): a write that finds this many
+/// first removes the oldest of the store's own table files, down to three quarters of it.
 pub const MAX_FILES: usize = 16_384;
 
 const MAGIC: &[u8; 8] = b"LAPTAB01";
@@ -46,8 +49,12 @@ const HEADER: usize = 8 + 3 * 4 + 16;
 pub struct Store {
     dir: PathBuf,
     build: u64,
-    /// Files in the folder when the store was opened, plus those it wrote since.
+    /// Files in the folder when the store was opened (or last pruned), plus those it wrote since.
     files: AtomicUsize,
+    /// The bound ([`MAX_FILES`] but in tests).
+    max_files: usize,
+    /// Held while the folder is pruned (one thread prunes; the others skip their write).
+    pruning: std::sync::Mutex<()>,
     /// Tables read back and tables measured (and offered to the folder).
     hits: AtomicU64,
     misses: AtomicU64,
@@ -113,11 +120,18 @@ fn build_identity() -> Option<u64> {
 impl Store {
     /// The store in `dir` for the program build `build` (the folder is made on the first write).
     pub fn open(dir: PathBuf, build: u64) -> Store {
+        Store::bounded(dir, build, MAX_FILES)
+    }
+
+    /// [`Store::open`] with another bound than [`MAX_FILES`].
+    fn bounded(dir: PathBuf, build: u64, max_files: usize) -> Store {
         let files = std::fs::read_dir(&dir).map_or(0, |d| d.count());
         Store {
             dir,
             build,
             files: AtomicUsize::new(files),
+            max_files,
+            pruning: std::sync::Mutex::new(()),
             hits: AtomicU64::new(0),
             misses: AtomicU64::new(0),
         }
@@ -128,9 +142,50 @@ impl Store {
         &self.dir
     }
 
-    /// Whether the folder holds [`MAX_FILES`] files or more (the store then writes nothing).
+    /// Whether the folder holds [`MAX_FILES`] files or more (the next write prunes it first).
     pub fn full(&self) -> bool {
-        self.files.load(Ordering::Relaxed) >= MAX_FILES
+        self.files.load(Ordering::Relaxed) >= self.max_files
+    }
+
+    /// Removes the oldest (by modification time) of the store's own table files — a name of 32
+    /// lowercase hex digits and `.tab`, a regular file that starts with the store's magic — until
+    /// the folder holds at most three quarters of the bound; nothing else in the folder is
+    /// touched. Returns whether there is room for a file.
+    fn prune(&self) -> bool {
+        let Ok(_one) = self.pruning.try_lock() else {
+            return false;
+        };
+        if !self.full() {
+            return true; // another thread pruned meanwhile
+        }
+        let Ok(entries) = std::fs::read_dir(&self.dir) else {
+            return false;
+        };
+        let mut total = 0;
+        let mut ours = Vec::new();
+        for e in entries.flatten() {
+            total += 1;
+            let path = e.path();
+            if is_table_name(&e.file_name())
+                && let Ok(meta) = std::fs::symlink_metadata(&path)
+                && meta.is_file()
+                && starts_with_magic(&path)
+            {
+                ours.push((meta.modified().unwrap_or(std::time::UNIX_EPOCH), path));
+            }
+        }
+        ours.sort();
+        let keep = self.max_files * 3 / 4;
+        for (_, path) in ours {
+            if total <= keep {
+                break;
+            }
+            if std::fs::remove_file(&path).is_ok() {
+                total -= 1;
+            }
+        }
+        self.files.store(total, Ordering::Relaxed);
+        total < self.max_files
     }
 
     /// Tables read back and tables measured so far.
@@ -186,7 +241,7 @@ impl Store {
     /// Puts `bytes` at `path` through a temporary file of the store's own; any failure leaves the
     /// folder as it was.
     fn write(&self, path: &Path, bytes: &[u8]) {
-        if self.full() {
+        if self.full() && !self.prune() {
             return;
         }
         if std::fs::create_dir_all(&self.dir).is_err() {
@@ -206,6 +261,27 @@ impl Store {
             let _ = std::fs::remove_file(&tmp);
         }
     }
+}
+
+/// Whether `name` is a table file's: 32 lowercase hex digits and `.tab`.
+fn is_table_name(name: &std::ffi::OsStr) -> bool {
+    name.to_str().is_some_and(|n| {
+        n.len() == 36
+            && n.ends_with(".tab")
+            && n[..32]
+                .bytes()
+                .all(|b| b.is_ascii_digit() || (b'a'..=b'f').contains(&b))
+    })
+}
+
+/// Whether the file at `path` starts with the store's magic.
+fn starts_with_magic(path: &Path) -> bool {
+    use std::io::Read as _;
+    let mut head = [0u8; 8];
+    std::fs::File::open(path)
+        .and_then(|mut f| f.read_exact(&mut head))
+        .is_ok()
+        && &head == MAGIC
 }
 
 /// A file's checksum of its values.
@@ -380,13 +456,43 @@ mod tests {
     }
 
     #[test]
-    fn a_full_store_stops_writing_and_an_unwritable_one_only_measures() {
+    fn a_full_store_removes_its_oldest_tables_and_nothing_else() {
         let dir = temp_dir("full");
-        let store = Store::open(dir.clone(), 1);
-        store.files.store(MAX_FILES, Ordering::Relaxed);
+        // Someone else's files in the folder: one named like a table but not one, one plain.
+        std::fs::create_dir_all(&dir).unwrap();
+        let lookalike = dir.join(format!("{:032x}.tab", 7));
+        std::fs::write(&lookalike, b"not a table at all").unwrap();
+        std::fs::write(dir.join("notes.txt"), b"mine").unwrap();
+        let store = Store::bounded(dir.clone(), 1, 8);
         let t = sample_table(0.1);
-        assert_eq!(store.table("x", &1, || t.clone()), t);
-        assert!(!dir.exists(), "nothing written past the bound");
+        for k in 0..6 {
+            store.table("x", &k, || t.clone());
+            std::thread::sleep(std::time::Duration::from_millis(5));
+        }
+        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 8);
+        assert!(store.full());
+        // The next write prunes to 6 (the two oldest tables of ours go), then writes.
+        store.table("x", &6, || t.clone());
+        let names: Vec<String> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().into_string().unwrap())
+            .collect();
+        assert_eq!(names.len(), 7, "{names:?}");
+        assert_eq!(std::fs::read(&lookalike).unwrap(), b"not a table at all");
+        assert_eq!(std::fs::read(dir.join("notes.txt")).unwrap(), b"mine");
+        let kept: Vec<bool> = (0..7)
+            .map(|k| {
+                dir.join(format!("{:032x}.tab", store.key("x", &k)))
+                    .exists()
+            })
+            .collect();
+        assert_eq!(kept, [false, false, true, true, true, true, true]);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn an_unwritable_folder_only_measures() {
+        let t = sample_table(0.1);
         // A folder that cannot be made (its parent is a file).
         let file = temp_dir("not-a-folder");
         std::fs::write(&file, b"mine").unwrap();

@@ -402,8 +402,8 @@ pub fn describe(recipe: &GemRecipe, scene: &Scene, points: u32) -> String {
                 std::fs::read_dir(store.dir()).map_or(0, |d| d.count()),
                 if store.full() {
                     format!(
-                        ", full: at most {} are kept, new tables are measured every run until \
-                         the folder is removed",
+                        ", at its bound of {}: the next table stored first removes the oldest \
+                         of the store's own files",
                         crate::bsdf::store::MAX_FILES
                     )
                 } else {
