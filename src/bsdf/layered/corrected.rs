@@ -363,7 +363,6 @@ static E_TOP: Memo<ETopKey, Arc<Table>> = Memo::new(4096);
 /// `Q` by stratified Monte Carlo over the Corrected sampling of the layers below, then `ρ̄`, `r_int`
 /// and the multiple lobe's constants.
 pub(super) fn build_tables(stack: &mut LayeredBsdf, l: usize, grid: usize) {
-    let n2 = (grid * grid * crate::bsdf::table::UC_STRATA) as f32;
     let top = stack.levels[l].top.clone();
     stack.levels[l].e_top = if stack.levels[l].smooth {
         // A delta reflection's albedo is the Fresnel factor itself.
@@ -389,13 +388,12 @@ pub(super) fn build_tables(stack: &mut LayeredBsdf, l: usize, grid: usize) {
         Table::clone(&table)
     };
 
-    let (eta, od) = (stack.levels[l].eta, stack.levels[l].od);
+    let eta = stack.levels[l].eta;
     let this = &*stack;
     // The stack's Debug text holds every input (this level's coat, the levels below it).
     let [albedo_rest, trapped] =
         crate::bsdf::store::tables("albedo_rest", &(l, grid, this), || {
-            let (albedo_rest, trapped) = measure_rest(this, l, grid, n2, eta, od);
-            [albedo_rest, trapped]
+            measure_rest(this, l, grid)
         });
 
     let lv = &stack.levels[l];
@@ -427,16 +425,11 @@ pub(super) fn build_tables(stack: &mut LayeredBsdf, l: usize, grid: usize) {
 
 /// `A` and `Q` of level `l` (the albedo of the layers below seen through its coat's absorption,
 /// and the part of it trapped by internal reflection), by stratified Monte Carlo over the Corrected
-/// sampling of the layers below (`n2` samples per entry).
-fn measure_rest(
-    this: &LayeredBsdf,
-    l: usize,
-    grid: usize,
-    n2: f32,
-    eta: f32,
-    od: RgbSample,
-) -> (Table, Table) {
-    Table::build_pair_par(|mu| {
+/// sampling of the layers below (`grid² · UC_STRATA` samples per entry).
+fn measure_rest(this: &LayeredBsdf, l: usize, grid: usize) -> [Table; 2] {
+    let n2 = (grid * grid * crate::bsdf::table::UC_STRATA) as f32;
+    let (eta, od) = (this.levels[l].eta, this.levels[l].od);
+    let (a, q) = Table::build_pair_par(|mu| {
         let wo_in = Vec3::new((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
         let (mut a, mut q) = (RgbSample::ZERO, RgbSample::ZERO);
         for_strata(
@@ -453,7 +446,8 @@ fn measure_rest(
             },
         );
         (a / n2, q / n2)
-    })
+    });
+    [a, q]
 }
 
 #[cfg(test)]
