@@ -108,20 +108,28 @@ fn wait_for_a_client(shared: &Shared) -> bool {
         return true;
     }
     let resume = s.phase;
+    let since = Instant::now();
     s.phase = Phase::Paused;
+    s.pauses += 1;
     shared.publish(s, |_| {});
     let mut s = shared.lock();
-    while s.last_client.elapsed() >= shared.idle {
+    let go_on = loop {
+        if s.last_client.elapsed() < shared.idle {
+            break true;
+        }
         if s.quit || shared.restart.load(Ordering::SeqCst) {
-            return false;
+            break false;
         }
         s = match shared.wake.wait_timeout(s, Duration::from_millis(500)) {
             Ok((g, _)) => g,
             Err(p) => p.into_inner().0,
         };
+    };
+    s.paused_seconds += since.elapsed().as_secs_f64();
+    if go_on {
+        s.phase = resume;
     }
-    s.phase = resume;
-    true
+    go_on
 }
 
 /// A draft frame of `scene` with the Corrected model's albedo calibration off (docs/accuracy.md:

@@ -225,6 +225,8 @@ pub fn status_json(ctx: &Context, s: &super::state::State) -> Value {
         "paths_per_second": s.paths_per_second,
         "elapsed": s.generation_start.elapsed().as_secs_f64(),
         "render_seconds": s.render_seconds,
+        "pauses": s.pauses,
+        "paused_seconds": s.paused_seconds,
         "first_pixels": s.first_pixels,
         "error_estimate": error_estimate,
         "error": s.error,

@@ -165,6 +165,12 @@ pub struct State {
     /// When a page last asked for anything: with no page for [`Shared::idle`] (the tab was
     /// closed) the worker pauses until one comes back.
     pub last_client: Instant,
+    /// How many times the worker has paused for want of a page this session (the status
+    /// reports it: a request that asks for the state also ends a pause, so `phase` alone
+    /// cannot show one afterwards).
+    pub pauses: u64,
+    /// Seconds the worker has spent paused this session.
+    pub paused_seconds: f64,
 }
 
 /// The state and the signals around it.
@@ -224,6 +230,8 @@ impl Shared {
                 refined_paths_per_second: None,
                 knob_costs: vec![],
                 last_client: now,
+                pauses: 0,
+                paused_seconds: 0.0,
             }),
             published: Condvar::new(),
             wake: Condvar::new(),
