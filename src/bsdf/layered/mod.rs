@@ -24,6 +24,7 @@ pub mod course;
 pub mod fluorescent;
 pub mod interface;
 pub mod ladder;
+pub(crate) mod level_tables;
 pub mod reference;
 
 use super::table::Table;
@@ -347,7 +348,7 @@ impl LayeredBsdf {
             *ts = ts.clone().with_compensation();
         }
         for l in (0..stack.levels.len()).rev() {
-            corrected::build_tables(&mut stack, l, TABLE_GRID);
+            level_tables::build_tables(&mut stack, l, TABLE_GRID);
         }
         stack.prepare_model();
         stack
