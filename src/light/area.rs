@@ -3,7 +3,7 @@
 //! Rectangles are sampled uniformly in the solid angle they subtend (Ureña, Fajardo & King, "An
 //! Area-Preserving Parametrization for Spherical Rectangles", EGSR 2013), which keeps the variance
 //! low for lights close to the shading point; where that solid angle is too small for the
-//! construction to be accurate (below [`MIN_SPHERICAL_SOLID_ANGLE`]) they fall back to uniform area
+//! construction to be accurate (below 10⁻⁶ sr) they fall back to uniform area
 //! sampling. Discs are sampled uniformly by area through the concentric map (Shirley & Chiu, "A
 //! Low Distortion Map Between Disk and Square", JGT 2(3), 1997). Area densities are turned into
 //! solid-angle densities by `pdf_ω = d² / (A |cos θ_light|)`.
@@ -11,6 +11,7 @@
 //! The choice between the two rectangle strategies depends only on the shading point, so
 //! [`Area::pdf`] always reproduces the density [`Area::sample`] used.
 
+use super::spherical_rect::SphericalRect;
 use super::{LightSample, positive_or_zero};
 use crate::color::Rgb;
 use crate::geometry::{Frame, Ray};
@@ -19,13 +20,8 @@ use crate::scene::stage::{AreaLight, LightShape};
 use crate::spectrum::Spectral;
 use crate::spectrum::line::Line;
 use crate::spectrum::measured::Measured;
-use glam::{DVec3, Vec2, Vec3};
+use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
-
-/// Solid angle in steradians below which a rectangle is sampled by area instead of by solid angle:
-/// under it the spherical construction loses digits to cancellation while area sampling is already
-/// nearly uniform in solid angle.
-pub const MIN_SPHERICAL_SOLID_ANGLE: f64 = 1e-6;
 
 /// Relative slack on the outline when [`Area::pdf`] re-intersects a direction, so a sample on the
 /// very edge still finds the light after rounding.
@@ -98,23 +94,6 @@ impl Beam {
     fn admits(&self, w: Vec3, n: Vec3) -> bool {
         w.dot(n) > 0.0 && w.cross(n).length_squared() <= self.sin2 * (1.0 + 1e-5)
     }
-}
-
-/// The spherical rectangle a rectangle subtends from a point `o` (Ureña et al. 2013, §3), in
-/// `f64`: in the local frame `axes = (x, y, z)` the rectangle spans `[x0, x1] × [y0, y1]` at
-/// `z = z0 < 0`, with `v0 = (x0, y0, z0)`.
-#[derive(Clone, Copy, Debug)]
-struct SphericalRect {
-    o: DVec3,
-    axes: [DVec3; 3],
-    v0: DVec3,
-    x1: f64,
-    y1: f64,
-    /// `z` of the normals of the planes through `o` and the edges at `y0` and `y1`.
-    b: (f64, f64),
-    k: f64,
-    /// Solid angle (sr).
-    solid_angle: f64,
 }
 
 /// How directions toward a light are drawn from a given point.
@@ -286,48 +265,10 @@ impl Area {
             }
         }
         let spherical = match self.outline {
-            Outline::Rect { hx, hy } => self.spherical_rect(p, hx, hy),
+            Outline::Rect { hx, hy } => SphericalRect::new(self.center, self.frame, (hx, hy), p),
             Outline::Disc { .. } => None,
         };
         Some(spherical.map_or(Strategy::Area, Strategy::Spherical))
-    }
-
-    /// Ureña et al. 2013, Algorithm 1 (initialisation), or `None` when the solid angle is too small
-    /// or not finite.
-    fn spherical_rect(&self, p: Vec3, hx: f32, hy: f32) -> Option<SphericalRect> {
-        let o = p.as_dvec3();
-        let (x, y) = (self.frame.s.as_dvec3(), self.frame.t.as_dvec3());
-        let (exl, eyl) = (2.0 * f64::from(hx), 2.0 * f64::from(hy));
-        let corner = self.center.as_dvec3() - x * f64::from(hx) - y * f64::from(hy);
-        let d = corner - o;
-        let mut z = x.cross(y);
-        let mut z0 = d.dot(z);
-        if z0 > 0.0 {
-            z = -z;
-            z0 = -z0;
-        }
-        let (x0, y0) = (d.dot(x), d.dot(y));
-        let (x1, y1) = (x0 + exl, y0 + eyl);
-        // Normals of the four planes through o and an edge.
-        let n0 = DVec3::new(0.0, z0, -y0).normalize();
-        let n1 = DVec3::new(-z0, 0.0, x1).normalize();
-        let n2 = DVec3::new(0.0, -z0, y1).normalize();
-        let n3 = DVec3::new(z0, 0.0, -x0).normalize();
-        let angle = |a: DVec3, b: DVec3| (-a.dot(b)).clamp(-1.0, 1.0).acos();
-        let (g0, g1, g2, g3) = (angle(n0, n1), angle(n1, n2), angle(n2, n3), angle(n3, n0));
-        let k = 2.0 * std::f64::consts::PI - g2 - g3;
-        let solid_angle = g0 + g1 - k;
-        let sr = SphericalRect {
-            o,
-            axes: [x, y, z],
-            v0: DVec3::new(x0, y0, z0),
-            x1,
-            y1,
-            b: (n0.z, n2.z),
-            k,
-            solid_angle,
-        };
-        (solid_angle.is_finite() && solid_angle > MIN_SPHERICAL_SOLID_ANGLE).then_some(sr)
     }
 
     /// A direction from `p` toward the light for next-event estimation, from `u ∈ [0, 1)²`.
@@ -421,38 +362,6 @@ impl Area {
             }
         };
         positive_or_zero(pdf)
-    }
-}
-
-impl SphericalRect {
-    /// Ureña et al. 2013, Algorithm 1 (sampling): the point on the rectangle whose direction is
-    /// uniformly distributed over the spherical rectangle.
-    fn sample(&self, u: Vec2) -> DVec3 {
-        let (u, v) = (f64::from(u.x), f64::from(u.y));
-        let (
-            DVec3 {
-                x: x0,
-                y: y0,
-                z: z0,
-            },
-            (b0, b1),
-        ) = (self.v0, self.b);
-        let au = u * self.solid_angle + self.k;
-        let fu = (au.cos() * b0 - b1) / au.sin();
-        let cu = (1.0f64.copysign(fu) / (fu * fu + b0 * b0).sqrt()).clamp(-1.0, 1.0);
-        let xu = (-(cu * z0) / (1.0 - cu * cu).max(0.0).sqrt()).clamp(x0, self.x1);
-        let xu = if xu.is_nan() { x0 } else { xu };
-        let d = (xu * xu + z0 * z0).sqrt();
-        let h0 = y0 / (d * d + y0 * y0).sqrt();
-        let h1 = self.y1 / (d * d + self.y1 * self.y1).sqrt();
-        let hv = h0 + v * (h1 - h0);
-        let yv = if hv * hv < 1.0 - 1e-12 {
-            (hv * d / (1.0 - hv * hv).sqrt()).clamp(y0, self.y1)
-        } else {
-            self.y1
-        };
-        let [x, y, z] = self.axes;
-        self.o + x * xu + y * yv + z * z0
     }
 }
 

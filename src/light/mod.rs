@@ -15,6 +15,7 @@
 pub mod area;
 pub mod distribution;
 pub mod environment;
+mod spherical_rect;
 
 pub use area::Area;
 pub use distribution::{Distribution1D, Distribution2D};
