@@ -3,8 +3,9 @@
 //! instead of being killed half way.
 //!
 //! The figures are measured, not derived from first principles (release build, `lapidary render`
-//! peak resident size): the film costs [`FILM_BYTES_PER_PIXEL`] a pixel (the accumulated
-//! [`PixelSums`] and, during a pass, the tiles' new sums before they are merged), an environment
+//! peak resident size): the film costs [`FILM_BYTES_PER_PIXEL`] a pixel (the tiles'
+//! accumulated [`PixelSums`] and the film assembled from them, or a part's copy of its tiles'
+//! sums from before a pass), an environment
 //! map [`MAP_BYTES_PER_TEXEL`] a texel while it is decoded and its tables built, a material's
 //! tables about [`MATERIAL_BYTES`], a mesh about [`MESH_BYTES_PER_FILE_BYTE`] times its OBJ file.
 
@@ -13,9 +14,10 @@ use crate::scene::Scene;
 use crate::scene::stage::{Environment, Shape};
 use std::fmt;
 
-/// Film bytes per pixel: two [`PixelSums`] (the film and a pass's new tile sums, 2 × 192 bytes
-/// of fixed-point sums) and room for the outputs' channels; measured 377 bytes a pixel at
-/// 2048×2048 (peak resident size of a 1-spp render, process included).
+/// Film bytes per pixel: two [`PixelSums`] (the tiles' sums and the film assembled from them,
+/// 2 × 192 bytes of fixed-point sums) and room for the outputs' channels; measured 377 bytes a
+/// pixel at 2048×2048 (peak resident size of a 1-spp render, process included; the same before
+/// and after the tiles kept their sums across passes: 1 582 944 and 1 583 000 KiB).
 pub const FILM_BYTES_PER_PIXEL: u64 = 2 * std::mem::size_of::<PixelSums>() as u64 + 16;
 /// More film bytes per pixel with the Stokes AOVs (`--stokes`): two [`super::film::StokesSums`].
 pub const STOKES_BYTES_PER_PIXEL: u64 = 2 * std::mem::size_of::<super::film::StokesSums>() as u64;
