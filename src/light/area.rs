@@ -255,7 +255,7 @@ impl Area {
             return None;
         }
         if let Some(beam) = self.beam {
-            // A beam (issue 20): only the light's points within the cone's footprint reach `p`;
+            // A beam (a laser's divergence, docs/fluorescence.md): only the light's points within the cone's footprint reach `p`;
             // sampling the footprint instead of the whole light finds them every time. Where the
             // footprint is larger than the light, area sampling wastes less.
             let radius = side * beam.tan;

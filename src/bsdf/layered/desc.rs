@@ -128,15 +128,15 @@ pub struct StackDesc {
     /// Multiple-scattering energy compensation (Turquin 2019) of a conductor base (Corrected and
     /// Reference) and of the coats' interfaces (Reference). The Course model never uses it.
     pub compensation: bool,
-    /// The Corrected model's albedo calibration to the adding solution ([`calibrate`]); on by
+    /// The Corrected model's albedo calibration to the adding solution ([`super::calibrate`]); on by
     /// default, off to measure what it buys (`tradeoff` knob `calibration`).
     pub calibration: bool,
     /// A measured albedo spectrum of a Lambert or Oren–Nayar base (the `albedo` above is its RGB
     /// projection). Spectral renders read it per wavelength: a stack without coats directly, one
-    /// under coats that do not absorb through its albedo ladder ([`ladder`]); otherwise a coated
+    /// under coats that do not absorb through its albedo ladder ([`super::ladder`]); otherwise a coated
     /// stack's spectral value is its RGB value as a spectrum ([`crate::bsdf::spectral`]).
     pub base_spectrum: Option<&'static crate::spectrum::measured::Measured>,
-    /// A fluorescent colorant in a Lambert base (issue 20, [`fluorescent`]): the base's albedo
+    /// A fluorescent colorant in a Lambert base (docs/fluorescence.md, [`super::fluorescent`]): the base's albedo
     /// (and `base_spectrum`) are then its elastic reflectance; the colorant adds the fluorescent
     /// lobe. Coats above it must not absorb.
     pub fluorescence: Option<std::sync::Arc<crate::spectrum::fluorescence::Fluorescence>>,

@@ -199,7 +199,7 @@ pub struct Shared {
 }
 
 impl Shared {
-    /// A session for `recipe` (nothing loaded yet: [`run_worker`] does it).
+    /// A session for `recipe` (nothing loaded yet: [`super::session::run_worker`] does it).
     pub fn new(
         recipe: PathBuf,
         request: Request,
