@@ -87,6 +87,12 @@ pub trait Bxdf<S: Spectral = RgbSample> {
     /// Density per steradian with which `sample_mode(wo, ·)` produces `wi` (the same in both
     /// modes; 0 for specular lobes).
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32;
+    /// `(eval_mode(wo, wi, mode), pdf(wo, wi))`, bit for bit: next-event estimation needs both,
+    /// and a model whose value and density share work computes it once.
+    #[inline]
+    fn eval_pdf_mode(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> (S, f32) {
+        (self.eval_mode(wo, wi, mode), self.pdf(wo, wi))
+    }
     /// [`Bxdf::eval_mode`] for radiance.
     #[inline]
     fn eval(&self, wo: Vec3, wi: Vec3) -> S {
@@ -159,6 +165,18 @@ impl Bxdf for Bsdf {
             Bsdf::Dielectric(b) => b.pdf(wo, wi),
             Bsdf::SmoothDielectric(b) => b.pdf(wo, wi),
             Bsdf::Layered(b) => b.pdf(wo, wi),
+        }
+    }
+    #[inline]
+    fn eval_pdf_mode(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> (RgbSample, f32) {
+        match self {
+            // Its value does not depend on the mode.
+            Bsdf::TorranceSparrow(b) => b.eval_pdf(wo, wi),
+            Bsdf::Layered(b) => b.eval_pdf_mode(wo, wi, mode),
+            _ => (
+                self.eval_mode(wo, wi, mode),
+                Bxdf::<RgbSample>::pdf(self, wo, wi),
+            ),
         }
     }
 }

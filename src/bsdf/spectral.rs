@@ -27,6 +27,7 @@
 //!
 //! The spectral variant's implementation is `bsdf::hero`.
 
+use super::layered::lobes::WeightsMemo;
 use super::{Bsdf, BsdfSample, Bxdf, TransportMode};
 use crate::spectrum::{RgbSample, RgbWavelengths, Spectral};
 use glam::{Vec2, Vec3};
@@ -49,6 +50,48 @@ pub trait Scatter<S: Spectral> {
     ) -> Option<BsdfSample<S>>;
     /// Density of `wi` from `wo` ([`Bxdf::pdf`]), for the hero wavelength's sampling.
     fn pdf_at(&self, wo: Vec3, wi: Vec3, lambda: &S::Wavelengths) -> f32;
+    /// `(eval_at(wo, wi, mode, lambda), pdf_at(wo, wi, lambda))` bit for bit
+    /// ([`Bxdf::eval_pdf_mode`]: a model computes what the two share once).
+    #[inline]
+    fn eval_pdf_at(
+        &self,
+        wo: Vec3,
+        wi: Vec3,
+        mode: TransportMode,
+        lambda: &S::Wavelengths,
+    ) -> (S, f32) {
+        (
+            self.eval_at(wo, wi, mode, lambda),
+            self.pdf_at(wo, wi, lambda),
+        )
+    }
+    /// [`Scatter::eval_pdf_at`] for a path vertex that keeps `memo` between this call and
+    /// [`Scatter::sample_memo`] for the same `wo` (a layer stack's lobe weights); bit for bit.
+    #[inline]
+    fn eval_pdf_memo(
+        &self,
+        wo: Vec3,
+        wi: Vec3,
+        mode: TransportMode,
+        lambda: &S::Wavelengths,
+        _memo: &WeightsMemo,
+    ) -> (S, f32) {
+        self.eval_pdf_at(wo, wi, mode, lambda)
+    }
+    /// [`Scatter::sample_at`] with the vertex's `memo` ([`Scatter::eval_pdf_memo`]); bit for
+    /// bit.
+    #[inline]
+    fn sample_memo(
+        &self,
+        wo: Vec3,
+        uc: f32,
+        u: Vec2,
+        mode: TransportMode,
+        lambda: &S::Wavelengths,
+        _memo: &WeightsMemo,
+    ) -> Option<BsdfSample<S>> {
+        self.sample_at(wo, uc, u, mode, lambda)
+    }
     /// For a smooth dielectric interface, its relative IOR (below over above) at the wavelength
     /// of `channel`; `None` for every other model and for a channel the path no longer carries
     /// (what polarised transport turns into Fresnel's Mueller matrices,
@@ -93,6 +136,45 @@ impl Scatter<RgbSample> for Bsdf {
     #[inline]
     fn pdf_at(&self, wo: Vec3, wi: Vec3, _: &RgbWavelengths) -> f32 {
         Bxdf::<RgbSample>::pdf(self, wo, wi)
+    }
+    #[inline]
+    fn eval_pdf_at(
+        &self,
+        wo: Vec3,
+        wi: Vec3,
+        mode: TransportMode,
+        _: &RgbWavelengths,
+    ) -> (RgbSample, f32) {
+        self.eval_pdf_mode(wo, wi, mode)
+    }
+    #[inline]
+    fn eval_pdf_memo(
+        &self,
+        wo: Vec3,
+        wi: Vec3,
+        mode: TransportMode,
+        _: &RgbWavelengths,
+        memo: &WeightsMemo,
+    ) -> (RgbSample, f32) {
+        match self {
+            Bsdf::Layered(b) => b.eval_pdf_memo(wo, wi, mode, memo),
+            _ => self.eval_pdf_mode(wo, wi, mode),
+        }
+    }
+    #[inline]
+    fn sample_memo(
+        &self,
+        wo: Vec3,
+        uc: f32,
+        u: Vec2,
+        mode: TransportMode,
+        _: &RgbWavelengths,
+        memo: &WeightsMemo,
+    ) -> Option<BsdfSample> {
+        match self {
+            Bsdf::Layered(b) => b.sample_memo(wo, uc, u, mode, memo),
+            _ => self.sample_mode(wo, uc, u, mode),
+        }
     }
     #[inline]
     fn interface_eta(&self, _channel: usize, _: &RgbWavelengths) -> Option<f32> {

@@ -277,9 +277,8 @@ impl Area {
     pub fn sample(&self, p: Vec3, u: Vec2) -> Option<LightSample> {
         match self.strategy(p)? {
             Strategy::Spherical(sr) => {
-                let q = sr.sample(u);
-                let d = q - sr.o;
-                let dist = d.length();
+                let (d, dist2) = sr.sample_offset(u);
+                let dist = dist2.sqrt();
                 let wi = (d / dist).as_vec3();
                 let pdf = (1.0 / sr.solid_angle) as f32;
                 self.record(wi, dist as f32, pdf)

@@ -16,14 +16,14 @@ pub(super) const MIN_SPHERICAL_SOLID_ANGLE: f64 = 1e-6;
 /// `z = z0 < 0`, with `v0 = (x0, y0, z0)`.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct SphericalRect {
-    /// The point it is seen from.
-    pub(super) o: DVec3,
     axes: [DVec3; 3],
     v0: DVec3,
     x1: f64,
     y1: f64,
     /// `z` of the normals of the planes through `o` and the edges at `y0` and `y1`.
     b: (f64, f64),
+    /// `|y|` of the first of those normals, `√(1 − b₀²)` without the cancellation.
+    a0: f64,
     k: f64,
     /// Solid angle (sr).
     pub(super) solid_angle: f64,
@@ -52,32 +52,43 @@ impl SphericalRect {
         }
         let (x0, y0) = (d.dot(x), d.dot(y));
         let (x1, y1) = (x0 + exl, y0 + eyl);
-        // Normals of the four planes through o and an edge.
-        let n0 = DVec3::new(0.0, z0, -y0).normalize();
-        let n1 = DVec3::new(-z0, 0.0, x1).normalize();
-        let n2 = DVec3::new(0.0, -z0, y1).normalize();
-        let n3 = DVec3::new(z0, 0.0, -x0).normalize();
-        let angle = |a: DVec3, b: DVec3| (-a.dot(b)).clamp(-1.0, 1.0).acos();
-        let (g0, g1, g2, g3) = (angle(n0, n1), angle(n1, n2), angle(n2, n3), angle(n3, n0));
+        // The planes through o and the edges at y0, x1, y1, x0 have the normals
+        // (0, z0, −y0)/r0, (−z0, 0, x1)/r1, (0, −z0, y1)/r2 and (z0, 0, −x0)/r3, so the cosines
+        // of the angles between neighbours (the negated dot products of the paper's γᵢ) are
+        // products of two coordinates over two of the rᵢ: four square roots and no vector
+        // normalised.
+        let zz = z0 * z0;
+        let (r0, r1, r2, r3) = (
+            (zz + y0 * y0).sqrt(),
+            (zz + x1 * x1).sqrt(),
+            (zz + y1 * y1).sqrt(),
+            (zz + x0 * x0).sqrt(),
+        );
+        let angle = |c: f64| c.clamp(-1.0, 1.0).acos();
+        let g0 = angle(y0 * x1 / (r0 * r1));
+        let g1 = angle(-(x1 * y1) / (r1 * r2));
+        let g2 = angle(x0 * y1 / (r2 * r3));
+        let g3 = angle(-(x0 * y0) / (r3 * r0));
         let k = 2.0 * std::f64::consts::PI - g2 - g3;
         let solid_angle = g0 + g1 - k;
         let sr = Self {
-            o,
             axes: [x, y, z],
             v0: DVec3::new(x0, y0, z0),
             x1,
             y1,
-            b: (n0.z, n2.z),
+            b: (-y0 / r0, y1 / r2),
+            a0: -z0 / r0,
             k,
             solid_angle,
         };
         (solid_angle.is_finite() && solid_angle > MIN_SPHERICAL_SOLID_ANGLE).then_some(sr)
     }
 
-    /// Ureña et al. 2013, Algorithm 1 (sampling): the point on the rectangle whose direction is
-    /// uniformly distributed over the spherical rectangle.
+    /// Ureña et al. 2013, Algorithm 1 (sampling): the vector from the point it is seen from to the point
+    /// on the rectangle whose direction is uniformly distributed over the spherical rectangle,
+    /// and its squared length.
     #[inline]
-    pub(super) fn sample(&self, u: Vec2) -> DVec3 {
+    pub(super) fn sample_offset(&self, u: Vec2) -> (DVec3, f64) {
         let (u, v) = (f64::from(u.x), f64::from(u.y));
         let (
             DVec3 {
@@ -88,13 +99,19 @@ impl SphericalRect {
             (b0, b1),
         ) = (self.v0, self.b);
         let au = u * self.solid_angle + self.k;
-        let fu = (au.cos() * b0 - b1) / au.sin();
-        let cu = (1.0f64.copysign(fu) / (fu * fu + b0 * b0).sqrt()).clamp(-1.0, 1.0);
-        let xu = (-(cu * z0) / (1.0 - cu * cu).max(0.0).sqrt()).clamp(x0, self.x1);
+        let (sin, cos) = au.sin_cos();
+        let fu = (cos * b0 - b1) / sin;
+        // The paper's cu = sign(fu) / √(fu² + b0²) and xu = −cu z0 / √(1 − cu²) in one step:
+        // xu = −sign(fu) z0 / √(fu² − (1 − b0²)), with 1 − b0² = a0² and the difference of
+        // squares factored (no cancellation where fu ≈ ±a0). Where the root is 0 or not a number
+        // the point is an end of [x0, x1], as the paper's clamps make it.
+        let root = ((fu - self.a0) * (fu + self.a0)).max(0.0).sqrt();
+        let xu = (-(1.0f64.copysign(fu) * z0) / root).clamp(x0, self.x1);
         let xu = if xu.is_nan() { x0 } else { xu };
-        let d = (xu * xu + z0 * z0).sqrt();
-        let h0 = y0 / (d * d + y0 * y0).sqrt();
-        let h1 = self.y1 / (d * d + self.y1 * self.y1).sqrt();
+        let dd = xu * xu + z0 * z0;
+        let d = dd.sqrt();
+        let h0 = y0 / (dd + y0 * y0).sqrt();
+        let h1 = self.y1 / (dd + self.y1 * self.y1).sqrt();
         let hv = h0 + v * (h1 - h0);
         let yv = if hv * hv < 1.0 - 1e-12 {
             (hv * d / (1.0 - hv * hv).sqrt()).clamp(y0, self.y1)
@@ -102,6 +119,6 @@ impl SphericalRect {
             self.y1
         };
         let [x, y, z] = self.axes;
-        self.o + x * xu + y * yv + z * z0
+        (x * xu + y * yv + z * z0, dd + yv * yv)
     }
 }

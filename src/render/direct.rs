@@ -66,7 +66,14 @@ where
     if !sb.admits(ls.wi) || (world.transmission_off && ls.wi.dot(sb.ng) < 0.0) {
         return S::ZERO;
     }
-    let (wi_local, f) = sb.eval::<S>(wo_local, ls.wi, &path.lambda);
+    // With MIS the BSDF's density toward the light is needed too (unless the light is hidden):
+    // found with the value, which shares most of its work.
+    let (wi_local, f, bsdf_pdf) = if strategy == Strategy::Mis {
+        sb.eval_pdf::<S>(wo_local, ls.wi, &path.lambda)
+    } else {
+        let (wi_local, f) = sb.eval::<S>(wo_local, ls.wi, &path.lambda);
+        (wi_local, f, 0.0)
+    };
     if f.is_black() {
         return S::ZERO;
     }
@@ -82,7 +89,7 @@ where
     }
     let p_light = p_pick * ls.pdf;
     let w = match strategy {
-        Strategy::Mis => power_heuristic(p_light, sb.pdf::<S>(wo_local, wi_local, &path.lambda)),
+        Strategy::Mis => power_heuristic(p_light, bsdf_pdf),
         _ => 1.0,
     };
     let radiance = match light {

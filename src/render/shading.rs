@@ -5,6 +5,7 @@
 
 use super::path::PathSample;
 use super::world::{Hit, World};
+use crate::bsdf::layered::lobes::WeightsMemo;
 use crate::bsdf::{
     Bsdf, BsdfSample, Bxdf, LayeredBsdf, Lobe, LobeFlags, LobeKind, Scatter, TransportMode,
 };
@@ -37,7 +38,7 @@ pub struct ShadingContext<W> {
 
 /// A material's scattering model placed at a hit: local-frame BSDF plus the frame and normals
 /// that decide which world directions it may scatter into.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct SurfaceBsdf<'a> {
     /// Hit point, world space.
     pub p: Vec3,
@@ -56,6 +57,9 @@ pub struct SurfaceBsdf<'a> {
     /// Set by [`SurfaceBsdf::fluoresce`]: the path took the fluorescent lobe of the base
     /// ([`crate::bsdf::layered::fluorescent`]), which `eval`, `pdf` and `sample` then describe.
     fluorescent: Option<&'a LayeredBsdf>,
+    /// What the vertex's light sample and continuation sample share (a layer stack's lobe
+    /// weights for `wo`).
+    memo: WeightsMemo,
 }
 
 impl<'a> SurfaceBsdf<'a> {
@@ -111,6 +115,36 @@ impl<'a> SurfaceBsdf<'a> {
             self.bxdf
                 .eval_at(wo_local, wi_local, TransportMode::Radiance, lambda),
         )
+    }
+
+    /// [`SurfaceBsdf::eval`] and the density [`SurfaceBsdf::pdf`] of the same pair, bit for bit
+    /// the two calls' results, computed together (next-event estimation with MIS needs both).
+    #[inline]
+    pub fn eval_pdf<S: Spectral>(
+        &self,
+        wo_local: Vec3,
+        wi: Vec3,
+        lambda: &S::Wavelengths,
+    ) -> (Vec3, S, f32)
+    where
+        Bsdf: Scatter<S>,
+    {
+        let wi_local = self.frame.to_local(wi);
+        if let Some(l) = self.fluorescent {
+            return (
+                wi_local,
+                S::splat(l.fluorescent_value(wo_local, wi_local)),
+                l.fluorescent_pdf(wo_local, wi_local),
+            );
+        }
+        let (f, pdf) = self.bxdf.eval_pdf_memo(
+            wo_local,
+            wi_local,
+            TransportMode::Radiance,
+            lambda,
+            &self.memo,
+        );
+        (wi_local, f, pdf)
     }
 
     /// The relative IOR (below over above the frame's `z`) of a smooth dielectric interface at
@@ -194,9 +228,14 @@ impl<'a> SurfaceBsdf<'a> {
                 };
                 BsdfSample::from_eval(fs.wi, S::splat(fs.value), fs.pdf, lobe)?
             }
-            None => self
-                .bxdf
-                .sample_at(wo_local, uc, u, TransportMode::Radiance, lambda)?,
+            None => self.bxdf.sample_memo(
+                wo_local,
+                uc,
+                u,
+                TransportMode::Radiance,
+                lambda,
+                &self.memo,
+            )?,
         };
         bs.wi = self.frame.to_world(bs.wi).normalize();
         self.admits(bs.wi).then_some(bs)
@@ -328,6 +367,7 @@ impl World {
             bxdf,
             flags: bxdf.flags(),
             fluorescent: None,
+            memo: WeightsMemo::default(),
         })
     }
 }

@@ -79,7 +79,7 @@ fn row(stack: &LayeredBsdf, o: usize) -> Row {
     let ms = lv.top_energy.as_ref().map_or(0.0, |e| e.split(wo).0);
     let top = RgbSample::splat(lv.e_top.values()[o][0] + ms);
     let mut transfer = vec![RgbSample::ZERO; NODES];
-    let (w, _) = corrected::lobe_weights(stack, 0, wo, true);
+    let (w, _) = super::lobes::lobe_weights(stack, 0, wo, true);
     let body_share = w[1] + w[2];
     if !(body_share > 0.0) {
         return Row { top, transfer };

@@ -21,10 +21,9 @@
 //! so `pdf = Σ w_k p_k` (course eq. 3.6) is exact; the lower lobe's pdf carries the refraction
 //! Jacobian `cos θi / (η² cos θi')`.
 
+use super::lobes::{LobeWeights, WeightsMemo, cone_cosine_pdf, escape_cone, lobe_weights};
 use super::{LayeredBsdf, course};
-use crate::bsdf::{
-    Bsdf, BsdfSample, Bxdf, Lobe, LobeKind, refract_macro, sample_cosine_hemisphere,
-};
+use crate::bsdf::{BsdfSample, Bxdf, Lobe, LobeKind, refract_macro, sample_cosine_hemisphere};
 use crate::spectrum::RgbSample;
 use glam::{Vec2, Vec3};
 use std::f32::consts::FRAC_1_PI;
@@ -72,31 +71,9 @@ pub(super) fn eval_parts(
     let Some(wi_in) = refract_macro(wi, lv.eta) else {
         return (top, RgbSample::ZERO);
     };
-    let mut body = RgbSample::ZERO;
-    {
-        let rest = eval(stack, l + 1, wo_in, wi_in);
-        if !rest.is_black() {
-            let exit = if stack.t_term() {
-                let h = (wo + wi).normalize_or_zero();
-                let g = if h.z > 0.0 && !lv.smooth {
-                    lv.top.distribution.g(wo, wi, h)
-                } else {
-                    1.0
-                };
-                (1.0 - g) + to * g
-            } else {
-                to
-            };
-            body = rest * lv.absorb(wo_in.z, wi_in.z) * (ti * exit / (lv.eta * lv.eta));
-        }
-    }
-    // Symmetric multiple-reflection lobe M · q(wo) q(wi) / ∫q cos (module docs); q(wi) = 0
-    // when wi cannot be reached from inside.
-    let qi = lv.trapped.at(wi_in.z) * ti;
-    (
-        top,
-        body + lv.trapped.at(wo_in.z) * qi * lv.multi_scale * to,
-    )
+    let rest = eval(stack, l + 1, wo_in, wi_in);
+    let body = lv.body(stack.t_term(), rest, (wo, wi), (wo_in, wi_in), (to, ti));
+    (top, body)
 }
 
 /// Evaluates level `l` under the analytic model selected by `corrected`.
@@ -109,72 +86,6 @@ fn eval_model(stack: &LayeredBsdf, l: usize, wo: Vec3, wi: Vec3, corrected: bool
     }
 }
 
-/// Smallest selection weight of a lobe that can contribute.
-const LOBE_FLOOR: f32 = 1e-5;
-
-/// Lobe-selection weights `[top, rest, multiple]` at level `l` for `wo` (sum 1, or all 0 when the
-/// level reflects nothing), and the refracted `wo'`.
-#[inline]
-pub(super) fn lobe_weights(
-    stack: &LayeredBsdf,
-    l: usize,
-    wo: Vec3,
-    corrected: bool,
-) -> ([f32; 3], Option<Vec3>) {
-    let lv = &stack.levels[l];
-    let e = lv.e_top.at(wo.z)[0].max(0.0);
-    let wo_in = refract_macro(wo, lv.eta);
-    let mut w = [e, 0.0, 0.0];
-    if let Some(wi) = wo_in {
-        let t = 1.0 - e;
-        let a = lv.albedo_rest.at(wi.z);
-        let q = lv.trapped.at(wi.z);
-        if corrected {
-            // The calibration scales the body's albedo by about c(μo)².
-            let c2 = match (&stack.calibration, l) {
-                (Some(c), 0) => {
-                    let c = c.at(wo.z);
-                    (c * c).luminance().max(0.0)
-                }
-                _ => 1.0,
-            };
-            w[1] = t * c2 * (a - q).luminance().max(0.0);
-            // The cosine lobe also carries the top interface's multiple-scattering reflection.
-            let ms = lv.top_energy.as_ref().map_or(0.0, |e| e.split(wo).0);
-            w[2] = t * c2 * (q * lv.multi_albedo).luminance().max(0.0) + ms;
-        } else {
-            w[1] = t * a.luminance().max(0.0);
-        }
-    }
-    // Floors keep every lobe that can be non-zero sampleable (pdf > 0 wherever f > 0), also where
-    // a table rounds a tiny albedo to 0 (e.g. m → 90°, where D·cos sampling almost always fails).
-    w[0] = w[0].max(LOBE_FLOOR);
-    if wo_in.is_some() {
-        w[1] = w[1].max(LOBE_FLOOR);
-        if corrected {
-            w[2] = w[2].max(LOBE_FLOOR);
-        }
-    }
-    let sum = w[0] + w[1] + w[2];
-    if sum > 0.0 && sum.is_finite() {
-        (w.map(|x| x / sum), wo_in)
-    } else {
-        ([0.0; 3], wo_in)
-    }
-}
-
-/// When the layer below level `l` is a diffuse base (Lambert or Oren–Nayar, sampled by cosine),
-/// the rest lobe samples only the **escape cone** `sin θ' < 1/η` — the inner directions that can
-/// leave — instead of the whole hemisphere, so no sample is spent on a direction that must fail.
-/// Returns the cone's squared disk radius `1/η²`, or `None` (glossy base, deeper coat, `η ≤ 1`).
-/// The tables still integrate the base over the whole hemisphere.
-#[inline]
-fn escape_cone(stack: &LayeredBsdf, l: usize) -> Option<f32> {
-    let eta = stack.levels[l].eta;
-    let diffuse = matches!(stack.base, Bsdf::Lambert(_) | Bsdf::OrenNayar(_));
-    (l + 1 == stack.levels.len() && diffuse && eta > 1.0).then(|| 1.0 / (eta * eta))
-}
-
 /// Cosine-weighted sampling restricted to the cone `sin²θ < r2`: Malley's method on the disk of
 /// radius `√r2`. Density `cos θ / (π r2)` inside the cone.
 #[inline]
@@ -184,16 +95,6 @@ fn sample_cone_cosine(u: Vec2, r2: f32) -> Option<Vec3> {
     let (x, y) = (d.x * r, d.y * r);
     let z = (1.0 - x * x - y * y).max(0.0).sqrt();
     (z > 0.0).then(|| Vec3::new(x, y, z))
-}
-
-/// Density of [`sample_cone_cosine`] for a direction known to lie in the cone.
-#[inline]
-fn cone_cosine_pdf(w: Vec3, r2: f32) -> f32 {
-    if w.z <= 0.0 {
-        0.0
-    } else {
-        w.z * FRAC_1_PI / r2
-    }
 }
 
 /// Density of the shared mixture at level `l`.
@@ -221,7 +122,7 @@ fn pdf_weighted(
     l: usize,
     wo: Vec3,
     wi: Vec3,
-    (w, wo_in): ([f32; 3], Option<Vec3>),
+    (w, wo_in): LobeWeights,
     corrected: bool,
 ) -> f32 {
     let lv = &stack.levels[l];
@@ -286,7 +187,7 @@ fn sample_dir_weighted(
     wo: Vec3,
     uc: f32,
     u: Vec2,
-    (w, wo_in): ([f32; 3], Option<Vec3>),
+    (w, wo_in): LobeWeights,
     corrected: bool,
 ) -> Option<(Vec3, Lobe)> {
     let lv = &stack.levels[l];
@@ -360,10 +261,26 @@ pub fn sample(
             return Some(s);
         }
     }
-    sample_general(stack, l, wo, uc, u, corrected)
+    sample_general(stack, l, wo, uc, u, corrected, None)
 }
 
-/// [`sample`] without the coat-less shortcut.
+/// [`sample`] of the Corrected model at the top level, with the lobe weights from `memo` (a
+/// vertex's, shared with its next-event estimation).
+pub fn sample_memo(
+    stack: &LayeredBsdf,
+    wo: Vec3,
+    uc: f32,
+    u: Vec2,
+    memo: &WeightsMemo,
+) -> Option<BsdfSample> {
+    if stack.levels.is_empty() {
+        return sample(stack, 0, wo, uc, u, true);
+    }
+    sample_general(stack, 0, wo, uc, u, true, Some(memo))
+}
+
+/// [`sample`] without the coat-less shortcut; the top level's Corrected weights from `memo` when
+/// given.
 fn sample_general(
     stack: &LayeredBsdf,
     l: usize,
@@ -371,6 +288,7 @@ fn sample_general(
     uc: f32,
     u: Vec2,
     corrected: bool,
+    memo: Option<&WeightsMemo>,
 ) -> Option<BsdfSample> {
     let Some(lv) = stack.levels.get(l).filter(|_| wo.z > 0.0) else {
         // The base alone, or `wo` below the coat (no direction then).
@@ -380,7 +298,10 @@ fn sample_general(
     };
     // The lobe weights for `wo`, once for the choice and the density (the same numbers as
     // `sample_dir` and `pdf` would find each).
-    let weights = lobe_weights(stack, l, wo, corrected);
+    let weights = match memo {
+        Some(m) if l == 0 && corrected => m.get(stack, wo),
+        _ => lobe_weights(stack, l, wo, corrected),
+    };
     let (wi, lobe) = sample_dir_weighted(stack, l, wo, uc, u, weights, corrected)?;
     if lobe.kind == LobeKind::SpecularReflection {
         // The smooth top coat's delta: it carries F(μo) of the flux and was chosen with the
@@ -389,13 +310,19 @@ fn sample_general(
         let value = lv.fresnel.eval(wo.z)[0];
         return BsdfSample::from_eval(wi, RgbSample::splat(value / wi.z), weights.0[0], lobe);
     }
-    let f = crate::bsdf::flush_tiny(eval_model(stack, l, wo, wi, corrected));
-    let pdf = if wi.z > 0.0 {
-        pdf_weighted(stack, l, wo, wi, weights, corrected)
+    let (f, pdf) = if corrected {
+        // The value and the density together (the top lobe's `D`, the refraction of `wi`).
+        super::joint::eval_pdf_weighted(stack, l, wo, wi, weights)
     } else {
-        0.0
+        let f = course::eval(stack, l, wo, wi);
+        let pdf = if wi.z > 0.0 {
+            pdf_weighted(stack, l, wo, wi, weights, corrected)
+        } else {
+            0.0
+        };
+        (f, pdf)
     };
-    BsdfSample::from_eval(wi, f, pdf, lobe)
+    BsdfSample::from_eval(wi, crate::bsdf::flush_tiny(f), pdf, lobe)
 }
 
 #[cfg(test)]
@@ -436,7 +363,7 @@ mod tests {
                 );
                 let (uc, u) = (rng.uniform(), rng.uniform2());
                 let fast = sample(&stack, 0, wo, uc, u, true);
-                let general = sample_general(&stack, 0, wo, uc, u, true);
+                let general = sample_general(&stack, 0, wo, uc, u, true, None);
                 assert_eq!(format!("{fast:?}"), format!("{general:?}"), "{base:?} {wo}");
                 some += usize::from(fast.is_some());
             }

@@ -24,8 +24,10 @@ pub mod course;
 mod desc;
 pub mod fluorescent;
 pub mod interface;
+pub mod joint;
 pub mod ladder;
 pub(crate) mod level_tables;
+pub mod lobes;
 pub mod reference;
 
 pub use desc::{Base, Coat, ConductorIor, Model, ReferenceParams, StackDesc, StackError, validate};
@@ -81,6 +83,43 @@ impl Level {
     #[inline]
     pub fn t(&self, cos: f32) -> f32 {
         (1.0 - self.e_top.at(cos)[0]).clamp(0.0, 1.0)
+    }
+
+    /// The body of the Corrected `f` at this level ([`corrected`]'s module docs): the layers
+    /// below, whose value at the refracted pair is `rest`, seen through the coat, plus the
+    /// symmetric multiple-reflection lobe `M · q(wo) q(wi) / ∫q cos` (`q(wi) = 0` where `wi`
+    /// cannot be reached from inside).
+    ///
+    /// # Arguments
+    /// * `t_term` – the stack's internal-reflection term ([`LayeredBsdf::t_term`]).
+    /// * `(wo, wi)` – the pair outside, `(wo_in, wi_in)` refracted into the coat.
+    /// * `(to, ti)` – the coat's transmission [`Level::t`] at `wo` and `wi`.
+    #[inline]
+    pub(crate) fn body(
+        &self,
+        t_term: bool,
+        rest: RgbSample,
+        (wo, wi): (Vec3, Vec3),
+        (wo_in, wi_in): (Vec3, Vec3),
+        (to, ti): (f32, f32),
+    ) -> RgbSample {
+        let mut body = RgbSample::ZERO;
+        if !rest.is_black() {
+            let exit = if t_term {
+                let h = (wo + wi).normalize_or_zero();
+                let g = if h.z > 0.0 && !self.smooth {
+                    self.top.distribution.g(wo, wi, h)
+                } else {
+                    1.0
+                };
+                (1.0 - g) + to * g
+            } else {
+                to
+            };
+            body = rest * self.absorb(wo_in.z, wi_in.z) * (ti * exit / (self.eta * self.eta));
+        }
+        let qi = self.trapped.at(wi_in.z) * ti;
+        body + self.trapped.at(wo_in.z) * qi * self.multi_scale * to
     }
 
     /// [`absorption`] in this coat, or 1 when its absorption code is off.
@@ -157,6 +196,42 @@ const SMOOTH_PLACEHOLDER: f32 = 0.01;
 const TABLE_GRID: usize = 16;
 
 impl LayeredBsdf {
+    /// [`Bxdf::eval_pdf_mode`] with the top level's lobe weights kept in `memo` (a path
+    /// vertex's, [`lobes::WeightsMemo`]); the same results bit for bit.
+    #[inline]
+    pub fn eval_pdf_memo(
+        &self,
+        wo: Vec3,
+        wi: Vec3,
+        mode: TransportMode,
+        memo: &lobes::WeightsMemo,
+    ) -> (RgbSample, f32) {
+        match self.model {
+            Model::Corrected => {
+                let (f, p) = joint::eval_pdf_memo(self, wo, wi, memo);
+                (super::flush_tiny(f), p)
+            }
+            _ => self.eval_pdf_mode(wo, wi, mode),
+        }
+    }
+
+    /// [`Bxdf::sample_mode`] with the top level's lobe weights kept in `memo`; the same sample
+    /// bit for bit.
+    #[inline]
+    pub fn sample_memo(
+        &self,
+        wo: Vec3,
+        uc: f32,
+        u: Vec2,
+        mode: TransportMode,
+        memo: &lobes::WeightsMemo,
+    ) -> Option<BsdfSample> {
+        match self.model {
+            Model::Corrected => corrected::sample_memo(self, wo, uc, u, memo),
+            _ => self.sample_mode(wo, uc, u, mode),
+        }
+    }
+
     /// Validates `desc` and builds its runtime tables (tens of milliseconds per material).
     pub fn new(desc: &StackDesc) -> Result<Self, StackError> {
         validate(desc)?;
@@ -412,6 +487,16 @@ impl Bxdf for LayeredBsdf {
             Model::Course => corrected::pdf(self, 0, wo, wi, false),
             Model::Corrected => corrected::pdf(self, 0, wo, wi, true),
             Model::Reference(_) => reference::pdf(self, wo, wi),
+        }
+    }
+    #[inline]
+    fn eval_pdf_mode(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> (RgbSample, f32) {
+        match self.model {
+            Model::Corrected => {
+                let (f, p) = joint::eval_pdf(self, 0, wo, wi);
+                (super::flush_tiny(f), p)
+            }
+            _ => (self.eval_mode(wo, wi, mode), self.pdf(wo, wi)),
         }
     }
 }

@@ -114,7 +114,7 @@ pub fn trace_packet(
             }
         }
         // Phases 2–4, lane by lane: emission, shading, the light sample and its BSDF value.
-        let mut vertices: [Option<Vertex>; L] = [None; L];
+        let mut vertices: [Option<Vertex>; L] = std::array::from_fn(|_| None);
         let mut shadow_o = V3::splat(glam::Vec3::ZERO);
         let mut shadow_d = V3::splat(glam::Vec3::ZERO);
         let mut shadow_t = F::splat(0.0);
@@ -217,7 +217,7 @@ fn intersect(world: &World, live: M, o: V3, d: V3) -> [Option<Hit>; L] {
 }
 
 /// A lane's surface vertex between the phases of a bounce.
-#[derive(Clone, Copy)]
+#[derive(Clone)]
 struct Vertex<'a> {
     /// The BSDF at the hit.
     sb: SurfaceBsdf<'a>,
