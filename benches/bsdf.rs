@@ -14,11 +14,13 @@
 //! parallel, are timed by the wall clock and by the process's CPU time. Elsewhere everything is wall
 //! time.
 //!
-//! Run with `cargo bench --bench bsdf` (release profile, about five minutes on two cores); a filter
-//! narrows it, e.g. `cargo bench --bench bsdf -- ratio`. No number here is asserted anywhere.
+//! Run with `cargo bench --bench bsdf` (release profile, about six minutes on two cores); a filter
+//! narrows it, e.g. `cargo bench --bench bsdf -- ratio` or `-- vertex` (a path vertex's light
+//! sample and continuation sample, separately and sharing their work). No number here is asserted anywhere.
 
 use criterion::{BenchmarkGroup, Criterion, SamplingMode, Throughput};
 use glam::{Vec2, Vec3};
+use lapidary::bsdf::layered::lobes::WeightsMemo;
 use lapidary::bsdf::{
     Base, BsdfSample, Bxdf, Coat, Distribution, Fresnel, FresnelMode, Lambert, LayeredBsdf,
     LobeFlags, Metal, MicrofacetDistribution, Model, OrenNayar, ReferenceParams, RoughDielectric,
@@ -238,6 +240,44 @@ fn materials(c: &mut Criterion<Clock>) {
     }
 }
 
+/// A path vertex's scattering work on every catalogue material under the Corrected model:
+/// next-event estimation's value and density toward a light, then the continuation sample — as
+/// two calls and a sample, and as one joint call and a sample that share the vertex's lobe
+/// weights (`LayeredBsdf::eval_pdf_memo`, `sample_memo`; bit for bit the same numbers, tested in
+/// `bsdf::layered::joint`). A fresh memo per vertex, as a path makes one.
+fn vertex(c: &mut Criterion<Clock>) {
+    let lib = MaterialLibrary::course();
+    let xs = batch(0xbe_0005, false);
+    let mut g = group(c, "vertex_corrected");
+    for name in lib.names() {
+        let stack = lib
+            .build(name, Some(Model::Corrected))
+            .expect("catalogue builds");
+        g.bench_function(format!("{name} separate"), |bn| {
+            bn.iter(|| {
+                let b = black_box(&stack);
+                for x in &xs {
+                    black_box(b.eval(black_box(x.wo), black_box(x.wi)));
+                    black_box(b.pdf(black_box(x.wo), black_box(x.wi)));
+                    black_box(b.sample(black_box(x.wo), black_box(x.uc), black_box(x.u)));
+                }
+            })
+        });
+        g.bench_function(format!("{name} joint"), |bn| {
+            bn.iter(|| {
+                let b = black_box(&stack);
+                for x in &xs {
+                    let memo = WeightsMemo::default();
+                    let r = TransportMode::Radiance;
+                    black_box(b.eval_pdf_memo(black_box(x.wo), black_box(x.wi), r, &memo));
+                    black_box(b.sample_memo(black_box(x.wo), black_box(x.uc), x.u, r, &memo));
+                }
+            })
+        });
+    }
+    g.finish();
+}
+
 /// What a compiled scene pays once per material: validating the description and building the
 /// stack's tables (`LayeredBsdf::new`). Course and Corrected build the same tables; a compensated
 /// Reference stack also builds its interfaces' energy tables. Table builds run in parallel (rayon),
@@ -329,6 +369,6 @@ fn config() -> Criterion<Clock> {
 criterion::criterion_group! {
     name = benches;
     config = config();
-    targets = ratio, components, materials, build
+    targets = ratio, components, materials, vertex, build
 }
 criterion::criterion_main!(benches);
