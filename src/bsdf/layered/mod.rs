@@ -85,43 +85,6 @@ impl Level {
         (1.0 - self.e_top.at(cos)[0]).clamp(0.0, 1.0)
     }
 
-    /// The body of the Corrected `f` at this level ([`corrected`]'s module docs): the layers
-    /// below, whose value at the refracted pair is `rest`, seen through the coat, plus the
-    /// symmetric multiple-reflection lobe `M · q(wo) q(wi) / ∫q cos` (`q(wi) = 0` where `wi`
-    /// cannot be reached from inside).
-    ///
-    /// # Arguments
-    /// * `t_term` – the stack's internal-reflection term ([`LayeredBsdf::t_term`]).
-    /// * `(wo, wi)` – the pair outside, `(wo_in, wi_in)` refracted into the coat.
-    /// * `(to, ti)` – the coat's transmission [`Level::t`] at `wo` and `wi`.
-    #[inline]
-    pub(crate) fn body(
-        &self,
-        t_term: bool,
-        rest: RgbSample,
-        (wo, wi): (Vec3, Vec3),
-        (wo_in, wi_in): (Vec3, Vec3),
-        (to, ti): (f32, f32),
-    ) -> RgbSample {
-        let mut body = RgbSample::ZERO;
-        if !rest.is_black() {
-            let exit = if t_term {
-                let h = (wo + wi).normalize_or_zero();
-                let g = if h.z > 0.0 && !self.smooth {
-                    self.top.distribution.g(wo, wi, h)
-                } else {
-                    1.0
-                };
-                (1.0 - g) + to * g
-            } else {
-                to
-            };
-            body = rest * self.absorb(wo_in.z, wi_in.z) * (ti * exit / (self.eta * self.eta));
-        }
-        let qi = self.trapped.at(wi_in.z) * ti;
-        body + self.trapped.at(wo_in.z) * qi * self.multi_scale * to
-    }
-
     /// [`absorption`] in this coat, or 1 when its absorption code is off.
     #[inline]
     pub fn absorb(&self, cos_a: f32, cos_b: f32) -> RgbSample {
