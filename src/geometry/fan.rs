@@ -94,14 +94,16 @@ impl<'a> Fan<'a> {
     }
 
     /// Whether [`Fan::intersect_curved`] knows the surface's curvature: a placed cabochon's
-    /// domes and base, and the flat faces of a faceted stone or a slab (zero). A mesh's normals
-    /// are interpolated, and a sphere's walks keep the finite-difference Jacobian the tests
-    /// compare the exact one with.
+    /// domes and base, a placed sphere, and the flat faces of a faceted stone or a slab (zero). A
+    /// mesh's normals are interpolated: its walks take a finite-difference Jacobian.
     #[inline]
     pub fn has_shape_operator(&self) -> bool {
         match self.kind {
             Kind::Cabochon(..) => true,
-            Kind::Solid(_) => matches!(self.stone.solid(), Solid::Polytope(_) | Solid::Slab(_)),
+            Kind::Solid(_) => matches!(
+                self.stone.solid(),
+                Solid::Polytope(_) | Solid::Slab(_) | Solid::Sphere(_)
+            ),
             Kind::Invalid => false,
         }
     }
@@ -111,11 +113,12 @@ impl<'a> Fan<'a> {
     #[inline]
     pub fn intersect_curved(&self, dir: Vec3, t_max: f32) -> Option<CurvedHit> {
         let Kind::Cabochon(c, org) = self.kind else {
-            let flat = self.has_shape_operator().then_some(Curvature::FLAT);
-            return self.intersect(dir, t_max).map(|hit| CurvedHit {
-                hit,
-                curvature: flat,
-            });
+            let hit = self.intersect(dir, t_max)?;
+            let curvature = match self.stone.solid() {
+                Solid::Sphere(s) => Some(self.sphere_curvature(s.radius(), &hit)?),
+                _ => self.has_shape_operator().then_some(Curvature::FLAT),
+            };
+            return Some(CurvedHit { hit, curvature });
         };
         if !valid_direction(dir, t_max) {
             return None;
@@ -137,6 +140,18 @@ impl<'a> Fan<'a> {
             hit,
             curvature: Some(curvature),
         })
+    }
+
+    /// The curvature at `hit` of a sphere of `radius` (object units) centred at the object
+    /// origin, placed by the stone's affine map `x = A u + b`: the world normal is `n = g/|g|`
+    /// with `g = N u / r` (`N` the normal matrix, `u` the object point), so `g = F x + const`
+    /// with `F = N A⁻¹ / r` ([`Curvature`]). `None` where it degenerates.
+    #[inline]
+    fn sphere_curvature(&self, radius: f32, hit: &StoneHit) -> Option<Curvature> {
+        let nw = self.stone.normal_to_world();
+        let field = nw * self.stone.to_object().matrix3 * radius.recip();
+        let inv_len = (nw * (hit.p_object / radius)).length().recip();
+        inv_len.is_finite().then_some(Curvature { field, inv_len })
     }
 
     /// The world hit from the object-space point and the world normals; `None` where they

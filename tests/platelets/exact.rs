@@ -5,7 +5,7 @@
 
 use super::manifold::{Lower, converge, light, lit_shape, measure_integrates, shaped_world, world};
 use glam::Vec3;
-use lapidary::render::manifold::{Chain, solve};
+use lapidary::render::manifold::{Chain, solve, solve_by_differences};
 use lapidary::sampler::Rng;
 use lapidary::scene::Effect;
 
@@ -39,16 +39,17 @@ fn exact_walk_measure_through_a_flat_face_integrates_to_the_refracted_solid_angl
     measure_integrates("Slab(size: (1.6, 1.2, 1.4))", &vertices);
 }
 
-/// The exact walk (a cabochon that is a unit sphere) and the finite-difference walk (the unit
-/// `Sphere`) against the connection solved in `f64` on the unit sphere in closed form (Newton
-/// with `f64` central differences from the walks' answer), for 2 000 random vertex–light-point
-/// pairs: each walk's direction within 2·10⁻⁴ rad of it and its measure within 2 %; the
-/// exact walk's measure must be at least as close on the whole (sum of relative errors). Measured:
+/// The exact walks (a cabochon that is a unit sphere, and the unit `Sphere` with its own
+/// curvature) and the finite-difference walk (the unit `Sphere`, [`solve_by_differences`])
+/// against the connection solved in `f64` on the unit sphere in closed form (Newton with `f64`
+/// central differences from the walks' answer), for 2 000 random vertex–light-point pairs: each
+/// walk's direction within 2·10⁻⁴ rad of it and its measure within 2 %; each exact walk's measure
+/// must be at least as close on the whole as the differences' (sum of relative errors). Measured:
 /// 1 557 pairs, mean relative error of the measure 2.3·10⁻⁵ (exact) and 4.9·10⁻⁵ (differences),
 /// worst direction 1.7·10⁻⁴ rad; the few errors above 0.3 % (≤ 1.2 %) are near a caustic, where
 /// the measure is ~100× its typical value and changes fast with the direction, which the walks'
 /// stopping tolerance (10⁻⁵ of the constraint) leaves uncertain by ~10⁻⁴ rad there. Where
-/// one walk fails the other may succeed only at the edge of reach (at most 1 % of the pairs).
+/// one walk fails another may succeed only at the edge of reach (at most 1 % of the pairs).
 #[test]
 fn exact_and_finite_difference_walks_agree() {
     let eta = 1.5;
@@ -57,7 +58,7 @@ fn exact_and_finite_difference_walks_agree() {
     let (c, n, _) = light(&fd);
     let mut rng = Rng::new(17);
     let (mut both, mut one) = (0, 0);
-    let (mut worst_angle, mut err_exact, mut err_fd) = (0.0f64, 0.0f64, 0.0f64);
+    let (mut worst_angle, mut err_exact, mut err_sphere, mut err_fd) = (0.0f64, 0.0, 0.0, 0.0);
     let pairs = 2000;
     for _ in 0..pairs {
         let x0 = loop {
@@ -72,13 +73,14 @@ fn exact_and_finite_difference_walks_agree() {
         match (
             solve(&exact, x0, x2, n, eta, Chain::Out),
             solve(&fd, x0, x2, n, eta, Chain::Out),
+            solve_by_differences(&fd, x0, x2, n, eta, Chain::Out),
         ) {
-            (Some(a), Some(b)) => {
+            (Some(a), Some(s), Some(b)) => {
                 both += 1;
                 let (x0, x2) = (x0.as_dvec3(), x2.as_dvec3());
                 let truth = sphere::solve(x0, x2, f64::from(eta), a.d.as_dvec3());
                 let measure = sphere::measure(x0, x2, f64::from(eta), truth);
-                for (walk, err) in [(a, &mut err_exact), (b, &mut err_fd)] {
+                for (walk, err) in [(a, &mut err_exact), (s, &mut err_sphere), (b, &mut err_fd)] {
                     let angle = walk.d.as_dvec3().cross(truth).length();
                     worst_angle = worst_angle.max(angle);
                     assert!(angle < 2e-4, "{x0} → {x2}: {} vs {truth}", walk.d);
@@ -87,22 +89,25 @@ fn exact_and_finite_difference_walks_agree() {
                     *err += rel;
                 }
             }
-            (None, None) => {}
+            (None, None, None) => {}
             _ => one += 1,
         }
     }
     println!(
-        "{both} connections found by both walks, {one} by one of them; worst angle \
-         {worst_angle:.2e} rad; mean |measure error| exact {:.2e}, finite differences {:.2e}",
+        "{both} connections found by every walk, {one} by some of them; worst angle \
+         {worst_angle:.2e} rad; mean |measure error| exact (cabochon) {:.2e}, exact (sphere) \
+         {:.2e}, finite differences {:.2e}",
         err_exact / f64::from(both),
+        err_sphere / f64::from(both),
         err_fd / f64::from(both)
     );
     assert!(both > pairs / 2, "{both} of {pairs}");
     assert!(
         one <= pairs / 100,
-        "{one} of {pairs} found by one walk only"
+        "{one} of {pairs} found by some walks only"
     );
     assert!(err_exact <= err_fd, "{err_exact} > {err_fd}");
+    assert!(err_sphere <= err_fd, "{err_sphere} > {err_fd}");
 }
 
 /// The refracted connection out of the unit sphere (IOR `eta` inside, light plane `y = 4`)

@@ -233,6 +233,9 @@ mod tests {
     const CABOCHON: &str = "Cabochon(radius: (1.1, 0.9), height: 0.95, base: 0.5)";
     /// A box resting on y = 0 (flat faces: the curvature is zero).
     const SLAB: &str = "Slab(size: (1.6, 1.2, 1.4))";
+    /// A sphere placed by a turn, a scale and a shift (its curvature is `1 / (1.3 · 0.8)`).
+    const SPHERE: &str = "Sphere(radius: 0.8), transform: (translate: (0.1, 0.3, -0.1), \
+                          rotate: (20.0, 35.0, 0.0), scale: 1.3)";
 
     /// The exact derivative against central differences of the constraint (step 5·10⁻⁴ rad,
     /// `f32`: their own error is up to ~2·10⁻³ of the derivative's size from truncation where the
@@ -327,6 +330,7 @@ mod tests {
             ) * 1.3
         };
         derivative_matches_differences(SLAB, Chain::Out, in_slab, 2000);
+        derivative_matches_differences(SPHERE, Chain::Out, inside, 2000);
     }
 
     #[test]
@@ -340,5 +344,6 @@ mod tests {
         };
         derivative_matches_differences(CABOCHON, Chain::Through, outside, 1000);
         derivative_matches_differences(SLAB, Chain::Through, outside, 1000);
+        derivative_matches_differences(SPHERE, Chain::Through, outside, 1000);
     }
 }

@@ -27,14 +27,14 @@
 //! 5–6 % darker than BSDF sampling's; with this one they agree within noise). Newton's method on the two tangent coordinates of `d`,
 //! seeded with the straight line `x0 → x2`, a step bounded by [`MAX_STEP`] and halved while the
 //! residual grows, at most [`MAX_ITERATIONS`] iterations; if that fails, a continuation in the
-//! index from `η = 1` ([`solve`]). On a cabochon, a faceted stone or a slab the Jacobian is
-//! exact at every iterate: the exit point's motion, the light direction's and the normal's
-//! through the surface's shape operator (`geometry::Curvature`: the domes', zero on flat faces),
-//! and for a [`Chain::Through`] the entry point's and Snell's law's there; one chain traced per
-//! iteration and none for the measure. A mesh's interpolated normals have no closed-form
-//! curvature, and the sphere keeps the finite-difference walk the tests compare the exact one
-//! with: there the Jacobian is taken by forward differences once and carried by Broyden's
-//! updates. A solution
+//! index from `η = 1` ([`solve`]). On a cabochon, a sphere, a faceted stone or a slab the
+//! Jacobian is exact at every iterate: the exit point's motion, the light direction's and the
+//! normal's through the surface's shape operator (`geometry::Curvature`: the domes' and the
+//! sphere's, zero on flat faces), and for a [`Chain::Through`] the entry point's and Snell's
+//! law's there; one chain traced per iteration and none for the measure. A mesh's interpolated
+//! normals have no closed-form curvature: there the Jacobian is taken by forward differences
+//! once and carried by Broyden's updates ([`solve_by_differences`] runs that walk on any stone,
+//! which the tests compare the exact one with). A solution
 //! must refract onto the light (the refracted ray heads for `x2`). Light points no refracted ray
 //! from `x0` reaches (near the boundary, many are: total internal reflection closes part of the
 //! sky) have no solution and contribute nothing, as they should; a reachable point the walk misses
@@ -79,7 +79,7 @@ pub use light::{
     walk_probability,
 };
 pub use newton::{MAX_ITERATIONS, MAX_STEP, TOLERANCE};
-pub use walk::{Connection, Exit, STAGES, exit, solve};
+pub use walk::{Connection, Exit, STAGES, exit, solve, solve_by_differences};
 
 use crate::light::Area;
 

@@ -289,6 +289,35 @@ pub fn solve(
     eta: f32,
     chain: Chain,
 ) -> Option<Connection> {
+    solve_with(world, x0, x2, n_light, eta, chain, true)
+}
+
+/// [`solve`] by finite differences and Broyden's updates even where the stone knows its
+/// curvature: the walk a mesh takes, and what the exact walk is tested against.
+///
+/// # Arguments
+/// As [`solve`].
+pub fn solve_by_differences(
+    world: &World,
+    x0: Vec3,
+    x2: Vec3,
+    n_light: Vec3,
+    eta: f32,
+    chain: Chain,
+) -> Option<Connection> {
+    solve_with(world, x0, x2, n_light, eta, chain, false)
+}
+
+/// [`solve`], with the exact Jacobian where the stone knows its curvature if `exact`.
+fn solve_with(
+    world: &World,
+    x0: Vec3,
+    x2: Vec3,
+    n_light: Vec3,
+    eta: f32,
+    chain: Chain,
+    exact: bool,
+) -> Option<Connection> {
     let seed = (x2 - x0).try_normalize()?;
     let problem = Problem {
         world,
@@ -299,7 +328,7 @@ pub fn solve(
     };
     // Where the stone knows its curvature the walk takes the exact Jacobian (no finite
     // differences); elsewhere Broyden's updates.
-    if problem.from.has_shape_operator() {
+    if exact && problem.from.has_shape_operator() {
         let stone = &world.stone;
         let walk =
             |p: &Problem, seed, tol| exact::newton(stone, &p.from, p.x2, p.eta, p.chain, seed, tol);
