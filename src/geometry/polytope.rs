@@ -373,6 +373,49 @@ mod tests {
         assert!(hits > 2_000, "{hits}");
     }
 
+    /// Rays through the box's edges and corners, where two or three planes give the same
+    /// quotient: the hit names the first of them in storage order, as a scan of every plane does.
+    #[test]
+    fn ties_name_the_first_plane_in_storage_order() {
+        let poly = Polytope::new(&box_planes(), "box").unwrap();
+        let mut ties = 0;
+        for corner in [
+            (1.0, 1.0, 1.5),
+            (-1.0, 0.0, -1.5),
+            (1.0, 0.0, -1.5),
+            (-1.0, 1.0, 1.5),
+        ] {
+            let c = Vec3::new(corner.0, corner.1, corner.2);
+            let centre = Vec3::new(0.0, 0.5, 0.0);
+            // Toward the corner and toward the middles of the three edges at it.
+            let mut aims = vec![c];
+            for a in 0..3 {
+                let mut m = c;
+                m[a] = centre[a];
+                aims.push(m);
+            }
+            for aim in aims {
+                for (o, dir) in [(aim + (aim - centre), centre - aim), (centre, aim - centre)] {
+                    let Some(h) = poly.intersect(&Ray::new(o, dir), f32::INFINITY) else {
+                        continue;
+                    };
+                    let leaving = h.ng.dot(dir) > 0.0;
+                    let q = |i: usize| {
+                        let den = poly.nx[i] * dir.x + poly.ny[i] * dir.y + poly.nz[i] * dir.z;
+                        let num =
+                            poly.d[i] - (poly.nx[i] * o.x + poly.ny[i] * o.y + poly.nz[i] * o.z);
+                        ((if leaving { den > 0.0 } else { den < 0.0 }) && num / den == h.t)
+                            .then_some(i)
+                    };
+                    let on: Vec<usize> = (0..poly.d.len()).filter_map(q).collect();
+                    ties += usize::from(on.len() > 1);
+                    assert_eq!(h.facet, Some(poly.facet[on[0]]), "{o} {dir}: {on:?}");
+                }
+            }
+        }
+        assert!(ties >= 8, "{ties}");
+    }
+
     #[test]
     fn degenerate_sets_are_errors() {
         let open: Vec<_> = box_planes().into_iter().take(5).collect();
