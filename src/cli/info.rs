@@ -367,13 +367,14 @@ pub fn describe(recipe: &GemRecipe, scene: &Scene, points: u32) -> String {
     if scene.surface.body.is_some() {
         let _ = writeln!(
             o,
-            "  medium       depth {}, scattering {}",
+            "  medium       depth {}, scattering {}; manifold walks retry by continuation: {}",
             r.medium_depth,
             if r.medium_scattering {
                 "on"
             } else {
                 "off (absorption only)"
-            }
+            },
+            if r.manifold_continuation { "on" } else { "off" }
         );
     }
 

@@ -152,6 +152,7 @@ fn knob_of(key: &str) -> Option<String> {
         "max-depth" | "max_depth" => Some("max-depth".into()),
         "medium-depth" | "medium_depth" => Some("medium-depth".into()),
         "medium-scattering" | "medium_scattering" => Some("medium-scattering".into()),
+        "manifold-continuation" | "manifold_continuation" => Some("manifold-continuation".into()),
         _ => effect_named(key).map(|e| e.name().to_string()),
     }
 }

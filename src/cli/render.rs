@@ -64,6 +64,10 @@ pub struct RenderArgs {
     /// Whether a body's medium scatters (`off`: absorption only; default: the recipe's, else on).
     #[arg(long, value_parser = super::knobs::switch_arg)]
     pub medium_scattering: Option<bool>,
+    /// Whether a manifold walk that fails from the straight line retries by the continuation
+    /// in the index (default: the recipe's, else off).
+    #[arg(long, value_parser = super::knobs::switch_arg)]
+    pub manifold_continuation: Option<bool>,
     /// Stop after this many seconds, setup included, and write what was rendered (marked
     /// partial; nothing when not one pass completed).
     #[arg(long, allow_hyphen_values = true, value_parser = parse_seconds)]
@@ -214,6 +218,9 @@ fn settings(args: &RenderArgs, scene: &mut Scene) {
     }
     if let Some(s) = args.medium_scattering {
         r.medium_scattering = s;
+    }
+    if let Some(c) = args.manifold_continuation {
+        r.manifold_continuation = c;
     }
     if let Some(e) = args.exposure {
         r.exposure = e;

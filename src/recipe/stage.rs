@@ -523,6 +523,9 @@ pub struct RenderDesc {
     /// Whether a body's medium scatters (default true; false: absorption only).
     #[serde(default)]
     pub medium_scattering: Option<bool>,
+    /// Whether a failed manifold walk retries by the continuation in the index (default false).
+    #[serde(default)]
+    pub manifold_continuation: Option<bool>,
     /// How a body's platelets are traced: `Explicit` (default, disc by disc) or `Statistical`
     /// (as a medium of oriented flakes).
     #[serde(default)]

@@ -63,9 +63,10 @@ impl Metadata {
             accuracy: scene.accuracy.to_string(),
             medium: scene.surface.body.as_ref().map(|_| {
                 format!(
-                    "medium-depth={},medium-scattering={}",
+                    "medium-depth={},medium-scattering={},manifold-continuation={}",
                     r.medium_depth,
-                    if r.medium_scattering { "on" } else { "off" }
+                    if r.medium_scattering { "on" } else { "off" },
+                    if r.manifold_continuation { "on" } else { "off" }
                 )
             }),
         }

@@ -164,7 +164,7 @@ impl Accuracy {
 }
 
 /// Every knob key [`Knobs::set`] accepts (the effect names of [`Effect::name`] work too).
-pub const KNOB_KEYS: [&str; 17] = [
+pub const KNOB_KEYS: [&str; 18] = [
     "model",
     "fresnel",
     "distribution",
@@ -182,6 +182,7 @@ pub const KNOB_KEYS: [&str; 17] = [
     "max-depth",
     "medium-depth",
     "medium-scattering",
+    "manifold-continuation",
 ];
 
 /// The effect a knob key names (`bump` is short for `facet-bump`).
@@ -264,6 +265,8 @@ pub struct Knobs {
     pub medium_depth: Option<u32>,
     /// Whether media scatter (`None`: the recipe's).
     pub medium_scattering: Option<bool>,
+    /// Whether failed manifold walks retry by the continuation (`None`: the recipe's).
+    pub manifold_continuation: Option<bool>,
     /// Platelets explicit (`true`) or statistical (`None`: the recipe's).
     pub platelets_explicit: Option<bool>,
 }
@@ -315,6 +318,9 @@ impl Knobs {
             "medium-scattering" | "medium_scattering" => {
                 self.medium_scattering = Some(parse_switch("medium-scattering", value)?);
             }
+            "manifold-continuation" | "manifold_continuation" => {
+                self.manifold_continuation = Some(parse_switch("manifold-continuation", value)?);
+            }
             _ => self.accuracy.set(key, value)?,
         }
         Ok(())
@@ -340,6 +346,9 @@ impl Knobs {
         }
         if let Some(s) = self.medium_scattering {
             scene.stage.render.medium_scattering = s;
+        }
+        if let Some(c) = self.manifold_continuation {
+            scene.stage.render.manifold_continuation = c;
         }
         if let Some(e) = self.platelets_explicit {
             scene.stage.render.platelets_explicit = e;
@@ -389,6 +398,12 @@ impl fmt::Display for Knobs {
             parts.push(format!(
                 "medium-scattering={}",
                 if s { "on" } else { "off" }
+            ));
+        }
+        if let Some(c) = self.manifold_continuation {
+            parts.push(format!(
+                "manifold-continuation={}",
+                if c { "on" } else { "off" }
             ));
         }
         if let Some(e) = self.platelets_explicit {

@@ -130,6 +130,7 @@ impl Stage {
                 max_depth: 8,
                 medium_depth: DEFAULT_MEDIUM_DEPTH,
                 medium_scattering: true,
+                manifold_continuation: false,
                 platelets_explicit: true,
                 sampler: SamplerKind::Sobol,
                 filter: Filter::Gaussian { radius: 1.5 },

@@ -192,6 +192,10 @@ pub struct RenderSettings {
     /// Whether media scatter (`medium-scattering=off`: the absorption-only approximation, where
     /// light that would scatter goes straight on).
     pub medium_scattering: bool,
+    /// Whether a manifold walk that fails from the straight line retries by the continuation in
+    /// the index (`manifold-continuation`; default off: measured, the retries find few
+    /// connections for their cost, and BSDF sampling keeps what the walk misses).
+    pub manifold_continuation: bool,
     /// Platelets traced one by one (`false`: their statistical form, a medium of flakes).
     pub platelets_explicit: bool,
     /// The sampler.

@@ -22,6 +22,7 @@ pub fn knob_choices() -> Value {
         "max-depth": null,
         "medium-depth": null,
         "medium-scattering": onoff,
+        "manifold-continuation": onoff,
     });
     for e in crate::scene::Effect::ALL {
         v[e.name()] = onoff.clone();

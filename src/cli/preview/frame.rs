@@ -211,6 +211,9 @@ fn knob_flags(knobs: &Knobs) -> String {
     if let Some(s) = knobs.medium_scattering {
         out += &format!(" --medium-scattering {}", onoff(s));
     }
+    if let Some(c) = knobs.manifold_continuation {
+        out += &format!(" --manifold-continuation {}", onoff(c));
+    }
     let k = &knobs.accuracy;
     if let Some(m) = k.model {
         out += &format!(" --model {m}");

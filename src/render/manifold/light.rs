@@ -3,7 +3,7 @@
 
 use super::ManifoldSetup;
 use super::chain::Chain;
-use super::walk::{last, solve};
+use super::walk::{last, solve_continued};
 use crate::bsdf::fresnel;
 use crate::geometry::{Ray, offset_origin};
 use crate::platelet::PlateletId;
@@ -77,7 +77,14 @@ pub fn sample_light<S: Spectral>(
     if !(u.walk < q) {
         return None;
     }
-    let c = solve(world, v.p, x2, light.normal(), setup.eta, v.chain)?;
+    let c = solve_continued(
+        world,
+        (v.p, x2),
+        light.normal(),
+        setup.eta,
+        v.chain,
+        setup.continuation,
+    )?;
     let x1 = c.exit.p;
     let u_out = (x2 - x1) / c.dist;
     let le = light.emitted(-u_out);
@@ -176,7 +183,14 @@ pub fn density(
     if !(p_pick > 0.0) {
         return 0.0;
     }
-    match solve(world, x0, x2, light.normal(), setup.eta, chain) {
+    match solve_continued(
+        world,
+        (x0, x2),
+        light.normal(),
+        setup.eta,
+        chain,
+        setup.continuation,
+    ) {
         Some(c) if c.d.dot(d) > 1.0 - SAME_DIRECTION => {
             let p = walk_probability(world, x0, x2, chain) * p_pick / (light.area() * c.jacobian);
             if p.is_finite() { p } else { 0.0 }

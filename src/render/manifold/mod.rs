@@ -27,7 +27,9 @@
 //! 5–6 % darker than BSDF sampling's; with this one they agree within noise). Newton's method on the two tangent coordinates of `d`,
 //! seeded with the straight line `x0 → x2`, a step bounded by [`MAX_STEP`] and halved while the
 //! residual grows, at most [`MAX_ITERATIONS`] iterations; if that fails, a continuation in the
-//! index from `η = 1` ([`solve`]). On a cabochon, a sphere, a faceted stone or a slab the
+//! index from `η = 1` ([`solve`]) — in a render only with the `manifold-continuation` knob on
+//! ([`solve_continued`]; off by default: the retries find few connections for their cost, and
+//! the MIS weight stays unbiased either way, its BSDF side running the same walk). On a cabochon, a sphere, a faceted stone or a slab the
 //! Jacobian is exact at every iterate: the exit point's motion, the light direction's and the
 //! normal's through the surface's shape operator (`geometry::Curvature`: the domes' and the
 //! sphere's, zero on flat faces), and for a [`Chain::Through`] the entry point's and Snell's
@@ -79,7 +81,7 @@ pub use light::{
     walk_probability,
 };
 pub use newton::{MAX_ITERATIONS, MAX_STEP, TOLERANCE};
-pub use walk::{Connection, Exit, STAGES, exit, solve, solve_by_differences};
+pub use walk::{Connection, Exit, STAGES, exit, solve, solve_by_differences, solve_continued};
 
 use crate::light::Area;
 
@@ -96,18 +98,22 @@ pub struct ManifoldSetup {
     pub inside: bool,
     /// Walks from the floor through the stone ([`Chain::Through`], effect `manifold-caustics`).
     pub through: bool,
+    /// A walk that fails from the straight line retries by the continuation in the index
+    /// (the `manifold-continuation` knob; [`solve_continued`]).
+    pub continuation: bool,
 }
 
 impl ManifoldSetup {
     /// The setup for a smooth boundary of relative IOR `eta` (material `boundary`) and the area
-    /// lights of the scene, walking from `inside` and/or `through` the stone; `None` when no
-    /// light emits or neither kind of walk is wanted.
+    /// lights of the scene, walking from `inside` and/or `through` the stone, with the
+    /// continuation in the index if `continuation`; `None` when no light emits or neither kind
+    /// of walk is wanted.
     pub fn new(
         eta: f32,
         boundary: u32,
         areas: &[Area],
-        inside: bool,
-        through: bool,
+        (inside, through): (bool, bool),
+        continuation: bool,
     ) -> Option<ManifoldSetup> {
         if !inside && !through {
             return None;
@@ -129,6 +135,7 @@ impl ManifoldSetup {
                 .collect(),
             inside,
             through,
+            continuation,
         })
     }
 

@@ -289,7 +289,26 @@ pub fn solve(
     eta: f32,
     chain: Chain,
 ) -> Option<Connection> {
-    solve_with(world, x0, x2, n_light, eta, chain, true)
+    solve_with(world, x0, x2, n_light, eta, chain, true, true)
+}
+
+/// [`solve`], with the continuation in the index only if `continuation` (the render's
+/// `manifold-continuation` knob): without it a walk that fails from the straight line gives up.
+/// The renderer's walks, on the light side and on the BSDF side of the MIS weight alike, so the
+/// combination stays unbiased either way (a connection the walk does not find is left whole to
+/// BSDF sampling).
+///
+/// # Arguments
+/// As [`solve`], and `continuation` – whether to retry from `η = 1`.
+pub fn solve_continued(
+    world: &World,
+    (x0, x2): (Vec3, Vec3),
+    n_light: Vec3,
+    eta: f32,
+    chain: Chain,
+    continuation: bool,
+) -> Option<Connection> {
+    solve_with(world, x0, x2, n_light, eta, chain, true, continuation)
 }
 
 /// [`solve`] by finite differences and Broyden's updates even where the stone knows its
@@ -305,10 +324,12 @@ pub fn solve_by_differences(
     eta: f32,
     chain: Chain,
 ) -> Option<Connection> {
-    solve_with(world, x0, x2, n_light, eta, chain, false)
+    solve_with(world, x0, x2, n_light, eta, chain, false, true)
 }
 
-/// [`solve`], with the exact Jacobian where the stone knows its curvature if `exact`.
+/// [`solve`], with the exact Jacobian where the stone knows its curvature if `exact`, and the
+/// continuation in the index if `continuation`.
+#[allow(clippy::too_many_arguments)]
 fn solve_with(
     world: &World,
     x0: Vec3,
@@ -317,6 +338,7 @@ fn solve_with(
     eta: f32,
     chain: Chain,
     exact: bool,
+    continuation: bool,
 ) -> Option<Connection> {
     let seed = (x2 - x0).try_normalize()?;
     let problem = Problem {
@@ -332,27 +354,31 @@ fn solve_with(
         let stone = &world.stone;
         let walk =
             |p: &Problem, seed, tol| exact::newton(stone, &p.from, p.x2, p.eta, p.chain, seed, tol);
-        let lin = continued(&problem, seed, walk, |l: &Linearised| l.d)?;
+        let lin = continued(&problem, seed, walk, |l: &Linearised| l.d, continuation)?;
         let e = exit_of(lin.hit, lin.w, eta, lin.entry())?;
         return connect(&problem, lin.d, e, n_light, Some(&lin));
     }
     let walk = |p: &Problem, seed, tol| p.newton(seed, tol);
-    let d = continued(&problem, seed, walk, |d: &Vec3| *d)?;
+    let d = continued(&problem, seed, walk, |d: &Vec3| *d, continuation)?;
     let e = exit_from(world, &problem.from, d, eta, chain)?;
     connect(&problem, d, e, n_light, None)
 }
 
 /// Newton's method by `walk` from `seed`, else the continuation in the index from `η = 1`
-/// through [`STAGES`] stages ([`solve`]); `dir` reads the converged direction off a walk's
-/// answer.
+/// through [`STAGES`] stages ([`solve`]) if `stages`; `dir` reads the converged direction off a
+/// walk's answer.
 fn continued<T>(
     problem: &Problem,
     seed: Vec3,
     walk: impl Fn(&Problem, Vec3, f32) -> Option<T>,
     dir: impl Fn(&T) -> Vec3,
+    stages: bool,
 ) -> Option<T> {
     if let Some(found) = walk(problem, seed, TOLERANCE) {
         return Some(found);
+    }
+    if !stages {
+        return None;
     }
     let mut d = seed;
     for k in 1..=STAGES {

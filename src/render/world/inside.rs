@@ -87,8 +87,11 @@ pub(super) fn build(scene: &Scene, stone: &Stone, areas: &[Area]) -> Result<Insi
             b.ior,
             scene.surface.body_index(),
             areas,
-            scene.effects.on(Effect::ManifoldNee),
-            scene.effects.on(Effect::ManifoldCaustics),
+            (
+                scene.effects.on(Effect::ManifoldNee),
+                scene.effects.on(Effect::ManifoldCaustics),
+            ),
+            stage.render.manifold_continuation,
         ),
         _ => None,
     };
