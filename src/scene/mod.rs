@@ -7,6 +7,7 @@
 
 pub mod accuracy;
 mod apply;
+pub mod knobs;
 pub(crate) use apply::stack_calls;
 pub mod body;
 pub mod effects;
@@ -15,9 +16,10 @@ pub mod stage;
 pub mod surface;
 pub mod view;
 
-pub use accuracy::{Accuracy, KnobError, Knobs};
+pub use accuracy::{Accuracy, KnobError};
 pub use body::{Body, Interior};
 pub use effects::{Effect, Effects};
+pub use knobs::Knobs;
 pub use stage::Stage;
 pub use surface::Surface;
 

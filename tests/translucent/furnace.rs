@@ -368,7 +368,7 @@ fn the_compensation_switch_gives_the_plain_interface() {
     assert!(mean < 0.9, "the plain interface keeps its energy: {mean}");
     // The knob, over a recipe that asks for compensation.
     let (mut scene, _) = build(&gem("(ior: 2.4, alpha: 0.5)", &stage(16)));
-    let knobs: lapidary::scene::accuracy::Knobs = "compensation=off".parse().unwrap();
+    let knobs: lapidary::scene::Knobs = "compensation=off".parse().unwrap();
     knobs.apply(&mut scene, "test").unwrap();
     let world = World::new(&scene).unwrap();
     match world.materials.last() {
