@@ -173,7 +173,8 @@ fn transmission_and_medium_forced_off_change_a_translucent_gem() {
 #[test]
 fn medium_knobs_change_a_scattering_body_and_nothing_else() {
     // `medium-scattering=off` (absorption only) and a short `medium-depth` change the milky
-    // stone; on an opaque gem the same knobs change nothing.
+    // stone; on an opaque gem the same knobs change nothing, nor does the manifold walks'
+    // continuation (no walk starts there).
     let knobs = |text: &str, s: &Scene| {
         let mut s = s.clone();
         let k: Knobs = text.parse().unwrap();
@@ -200,6 +201,8 @@ fn medium_knobs_change_a_scattering_body_and_nothing_else() {
         "medium-scattering=off",
         "medium-depth=0",
         "medium-depth=4096",
+        "manifold-continuation=on",
+        "manifold-continuation=off",
     ] {
         let (n, first) = differences(&auto, &film(&knobs(setting, &opaque)));
         assert_eq!(n, 0, "{setting} on sunstone: {}", first.unwrap_or_default());
