@@ -367,13 +367,14 @@ pub fn describe(recipe: &GemRecipe, scene: &Scene, points: u32) -> String {
     if scene.surface.body.is_some() {
         let _ = writeln!(
             o,
-            "  medium       depth {}, scattering {}; manifold walks retry by continuation: {}",
+            "  medium       depth {}, scattering {}; manifold walks halve a step at most {} times, retry by continuation: {}",
             r.medium_depth,
             if r.medium_scattering {
                 "on"
             } else {
                 "off (absorption only)"
             },
+            r.manifold_halvings,
             if r.manifold_continuation { "on" } else { "off" }
         );
     }

@@ -153,6 +153,7 @@ fn knob_of(key: &str) -> Option<String> {
         "medium-depth" | "medium_depth" => Some("medium-depth".into()),
         "medium-scattering" | "medium_scattering" => Some("medium-scattering".into()),
         "manifold-continuation" | "manifold_continuation" => Some("manifold-continuation".into()),
+        "manifold-halvings" | "manifold_halvings" => Some("manifold-halvings".into()),
         _ => effect_named(key).map(|e| e.name().to_string()),
     }
 }

@@ -68,6 +68,10 @@ pub struct RenderArgs {
     /// in the index (default: the recipe's, else off).
     #[arg(long, value_parser = super::knobs::switch_arg)]
     pub manifold_continuation: Option<bool>,
+    /// Most halvings of a manifold walk's Newton step that does not lower the residual before
+    /// the walk gives up (default: the recipe's, else 1)
+    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=8))]
+    pub manifold_halvings: Option<u32>,
     /// Stop after this many seconds, setup included, and write what was rendered (marked
     /// partial; nothing when not one pass completed).
     #[arg(long, allow_hyphen_values = true, value_parser = parse_seconds)]
@@ -221,6 +225,9 @@ fn settings(args: &RenderArgs, scene: &mut Scene) {
     }
     if let Some(c) = args.manifold_continuation {
         r.manifold_continuation = c;
+    }
+    if let Some(h) = args.manifold_halvings {
+        r.manifold_halvings = h;
     }
     if let Some(e) = args.exposure {
         r.exposure = e;

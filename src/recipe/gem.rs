@@ -203,6 +203,15 @@ mod tests {
     #[test]
     fn errors_point_at_the_problem() {
         let e = err(&format!(
+            "({MATS}\n surface: Material(\"a\"),\n stage: (render: (manifold_halvings: 9)))"
+        ));
+        assert_eq!(e.line, 3, "{e}");
+        assert!(
+            e.message.contains("manifold_halvings = 9") && e.message.contains("0 ..= 8"),
+            "{e}"
+        );
+
+        let e = err(&format!(
             "({MATS}\n surface: Voronoi(scale: 0.1,\n   fill: 1.5, entries: [(1.0, Material(\"a\"))]))"
         ));
         assert_eq!((e.line, e.col), (3, 10), "{e}");

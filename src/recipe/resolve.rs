@@ -332,6 +332,7 @@ pub(crate) fn stage(
     rs.medium_depth = rd.medium_depth.unwrap_or(rs.medium_depth);
     rs.medium_scattering = rd.medium_scattering.unwrap_or(rs.medium_scattering);
     rs.manifold_continuation = rd.manifold_continuation.unwrap_or(rs.manifold_continuation);
+    rs.manifold_halvings = rd.manifold_halvings.unwrap_or(rs.manifold_halvings);
     if let Some(f) = rd.platelets {
         rs.platelets_explicit = f == super::stage::PlateletForm::Explicit;
     }

@@ -157,6 +157,14 @@ fn depth_range<'de, D: Deserializer<'de>>(d: D) -> Result<Option<u32>, D::Error>
 fn medium_depth_range<'de, D: Deserializer<'de>>(d: D) -> Result<Option<u32>, D::Error> {
     count(d, "medium_depth", 0, crate::scene::stage::MAX_MEDIUM_DEPTH)
 }
+fn manifold_halvings_range<'de, D: Deserializer<'de>>(d: D) -> Result<Option<u32>, D::Error> {
+    count(
+        d,
+        "manifold_halvings",
+        0,
+        crate::scene::stage::MAX_MANIFOLD_HALVINGS,
+    )
+}
 pub(crate) fn seed_range<'de, D: Deserializer<'de>>(d: D) -> Result<Option<u64>, D::Error> {
     any_seed(d).map(Some)
 }
@@ -526,6 +534,9 @@ pub struct RenderDesc {
     /// Whether a failed manifold walk retries by the continuation in the index (default false).
     #[serde(default)]
     pub manifold_continuation: Option<bool>,
+    /// Most halvings of a manifold walk's Newton step, 0 ..= 8 (default 1).
+    #[serde(default, deserialize_with = "manifold_halvings_range")]
+    pub manifold_halvings: Option<u32>,
     /// How a body's platelets are traced: `Explicit` (default, disc by disc) or `Statistical`
     /// (as a medium of oriented flakes).
     #[serde(default)]

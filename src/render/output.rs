@@ -63,10 +63,12 @@ impl Metadata {
             accuracy: scene.accuracy.to_string(),
             medium: scene.surface.body.as_ref().map(|_| {
                 format!(
-                    "medium-depth={},medium-scattering={},manifold-continuation={}",
+                    "medium-depth={},medium-scattering={},manifold-continuation={},\
+                     manifold-halvings={}",
                     r.medium_depth,
                     if r.medium_scattering { "on" } else { "off" },
-                    if r.manifold_continuation { "on" } else { "off" }
+                    if r.manifold_continuation { "on" } else { "off" },
+                    r.manifold_halvings
                 )
             }),
         }

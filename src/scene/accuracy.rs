@@ -166,7 +166,7 @@ impl Accuracy {
 
 /// Every knob key [`Knobs::set`](super::Knobs::set) accepts (the effect names of [`Effect::name`]
 /// work too).
-pub const KNOB_KEYS: [&str; 18] = [
+pub const KNOB_KEYS: [&str; 19] = [
     "model",
     "fresnel",
     "distribution",
@@ -185,6 +185,7 @@ pub const KNOB_KEYS: [&str; 18] = [
     "medium-depth",
     "medium-scattering",
     "manifold-continuation",
+    "manifold-halvings",
 ];
 
 /// The effect a knob key names (`bump` is short for `facet-bump`).

@@ -1,5 +1,5 @@
 //! [`Knobs`]: an [`Accuracy`] plus the render-level knobs (sampler, depths, the medium's
-//! scattering, the manifold walks' continuation, the platelets' form), one setting of a
+//! scattering, the manifold walks' effort, the platelets' form), one setting of a
 //! `tradeoff` study written `key=value,key=value` (docs/accuracy.md). The material-level part is
 //! [`super::accuracy`]'s.
 
@@ -23,6 +23,8 @@ pub struct Knobs {
     pub medium_scattering: Option<bool>,
     /// Whether failed manifold walks retry by the continuation (`None`: the recipe's).
     pub manifold_continuation: Option<bool>,
+    /// Most halvings of a manifold walk's Newton step (`None`: the recipe's).
+    pub manifold_halvings: Option<u32>,
     /// Platelets explicit (`true`) or statistical (`None`: the recipe's).
     pub platelets_explicit: Option<bool>,
 }
@@ -77,6 +79,15 @@ impl Knobs {
             "manifold-continuation" | "manifold_continuation" => {
                 self.manifold_continuation = Some(parse_switch("manifold-continuation", value)?);
             }
+            "manifold-halvings" | "manifold_halvings" => {
+                let max = crate::scene::stage::MAX_MANIFOLD_HALVINGS;
+                let h: u32 = value.parse().ok().filter(|h| *h <= max).ok_or_else(|| {
+                    KnobError(format!(
+                        "manifold-halvings `{value}` is out of range: allowed 0 ..= {max}"
+                    ))
+                })?;
+                self.manifold_halvings = Some(h);
+            }
             _ => self.accuracy.set(key, value)?,
         }
         Ok(())
@@ -105,6 +116,9 @@ impl Knobs {
         }
         if let Some(c) = self.manifold_continuation {
             scene.stage.render.manifold_continuation = c;
+        }
+        if let Some(h) = self.manifold_halvings {
+            scene.stage.render.manifold_halvings = h;
         }
         if let Some(e) = self.platelets_explicit {
             scene.stage.render.platelets_explicit = e;
@@ -162,6 +176,9 @@ impl fmt::Display for Knobs {
                 if c { "on" } else { "off" }
             ));
         }
+        if let Some(h) = self.manifold_halvings {
+            parts.push(format!("manifold-halvings={h}"));
+        }
         if let Some(e) = self.platelets_explicit {
             parts.push(format!(
                 "platelets={}",
@@ -207,6 +224,11 @@ mod tests {
         assert!(e.contains("on, off"), "{e}");
         let e = "max-depth=0".parse::<Knobs>().unwrap_err().0;
         assert!(e.contains("1 ..= 1024"), "{e}");
+        let e = "manifold-halvings=9".parse::<Knobs>().unwrap_err().0;
+        assert!(e.contains("0 ..= 8"), "{e}");
+        let k: Knobs = "manifold-halvings=0".parse().unwrap();
+        assert_eq!(k.manifold_halvings, Some(0));
+        assert_eq!(k.to_string(), "manifold-halvings=0");
         let e = "colour=red".parse::<Knobs>().unwrap_err().0;
         assert!(e.contains("unknown knob") && e.contains("fresnel"), "{e}");
         let e = "bump".parse::<Knobs>().unwrap_err().0;

@@ -3,8 +3,8 @@
 //! own fields apply ([`crate::recipe`]).
 
 use super::stage::{
-    AreaLight, Camera, DEFAULT_MEDIUM_DEPTH, Environment, Filter, Ground, LightShape, Projection,
-    RenderSettings, SamplerKind, Shape, Stage, rect_light,
+    AreaLight, Camera, DEFAULT_MANIFOLD_HALVINGS, DEFAULT_MEDIUM_DEPTH, Environment, Filter,
+    Ground, LightShape, Projection, RenderSettings, SamplerKind, Shape, Stage, rect_light,
 };
 use crate::color::Rgb;
 use glam::{Affine3A, Vec3};
@@ -131,6 +131,7 @@ impl Stage {
                 medium_depth: DEFAULT_MEDIUM_DEPTH,
                 medium_scattering: true,
                 manifold_continuation: false,
+                manifold_halvings: DEFAULT_MANIFOLD_HALVINGS,
                 platelets_explicit: true,
                 sampler: SamplerKind::Sobol,
                 filter: Filter::Gaussian { radius: 1.5 },

@@ -196,6 +196,10 @@ pub struct RenderSettings {
     /// the index (`manifold-continuation`; default off: measured, the retries find few
     /// connections for their cost, and BSDF sampling keeps what the walk misses).
     pub manifold_continuation: bool,
+    /// Most halvings of a manifold walk's Newton step that does not lower the residual
+    /// (`manifold-halvings`), 0 ..= [`MAX_MANIFOLD_HALVINGS`] (default 1: measured, further
+    /// halvings cost many ray casts and find next to no connections).
+    pub manifold_halvings: u32,
     /// Platelets traced one by one (`false`: their statistical form, a medium of flakes).
     pub platelets_explicit: bool,
     /// The sampler.
@@ -212,6 +216,11 @@ pub struct RenderSettings {
 pub const DEFAULT_MEDIUM_DEPTH: u32 = 256;
 /// The largest [`RenderSettings::medium_depth`] a user may give.
 pub const MAX_MEDIUM_DEPTH: u32 = 4096;
+/// The default of [`RenderSettings::manifold_halvings`].
+pub const DEFAULT_MANIFOLD_HALVINGS: u32 = 1;
+/// The largest [`RenderSettings::manifold_halvings`] a user may give (a step shortened 256
+/// times: beyond it a walk only creeps).
+pub const MAX_MANIFOLD_HALVINGS: u32 = 8;
 
 /// A resolved stage.
 #[derive(Clone, Debug, PartialEq)]

@@ -203,6 +203,8 @@ fn medium_knobs_change_a_scattering_body_and_nothing_else() {
         "medium-depth=4096",
         "manifold-continuation=on",
         "manifold-continuation=off",
+        "manifold-halvings=0",
+        "manifold-halvings=8",
     ] {
         let (n, first) = differences(&auto, &film(&knobs(setting, &opaque)));
         assert_eq!(n, 0, "{setting} on sunstone: {}", first.unwrap_or_default());

@@ -23,6 +23,7 @@ pub fn knob_choices() -> Value {
         "medium-depth": null,
         "medium-scattering": onoff,
         "manifold-continuation": onoff,
+        "manifold-halvings": null,
     });
     for e in crate::scene::Effect::ALL {
         v[e.name()] = onoff.clone();

@@ -214,6 +214,9 @@ fn knob_flags(knobs: &Knobs) -> String {
     if let Some(c) = knobs.manifold_continuation {
         out += &format!(" --manifold-continuation {}", onoff(c));
     }
+    if let Some(h) = knobs.manifold_halvings {
+        out += &format!(" --manifold-halvings {h}");
+    }
     let k = &knobs.accuracy;
     if let Some(m) = k.model {
         out += &format!(" --model {m}");

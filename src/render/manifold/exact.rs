@@ -4,7 +4,7 @@
 //! needs no finite differences (module docs in [`super`]).
 
 use super::chain::{Chain, Entry, entry_at};
-use super::newton::{MAX_HALVINGS, MAX_ITERATIONS, step, turn};
+use super::newton::{MAX_ITERATIONS, Stop, step, turn};
 use crate::geometry::{Curvature, CurvedHit, Fan, Frame, Stone, StoneHit};
 use glam::{Vec2, Vec3};
 
@@ -158,16 +158,15 @@ pub(super) fn linearise(
 ///
 /// # Arguments
 /// * `stone`, `from` – the stone and the rays from the vertex.
-/// * `x2`, `eta`, `chain` – the light point, the index ratio and the chain ([`linearise`]).
-/// * `tolerance` – converged when `|C| <` this.
+/// * `(x2, eta, chain)` – the light point, the index ratio and the chain ([`linearise`]).
+/// * `stop` – converged when `|C| <` its tolerance; gives up when a step halved as often as it
+///   allows still does not lower `|C|`.
 pub(super) fn newton(
     stone: &Stone,
     from: &Fan,
-    x2: Vec3,
-    eta: f32,
-    chain: Chain,
+    (x2, eta, chain): (Vec3, f32, Chain),
     seed: Vec3,
-    tolerance: f32,
+    stop: Stop,
 ) -> Option<Linearised> {
     let linearise = |d: Vec3| linearise(stone, from, x2, eta, chain, d);
     let frame = Frame::from_normal(seed);
@@ -178,7 +177,7 @@ pub(super) fn newton(
     let mut a = Vec2::ZERO;
     let mut d = seed;
     for _ in 0..MAX_ITERATIONS {
-        if lin.c.length() < tolerance {
+        if lin.c.length() < stop.tolerance {
             return Some(lin);
         }
         // ∂d/∂a of `turn`: the frame's tangents projected off `d`, over |n + s a.x + t a.y|.
@@ -190,7 +189,7 @@ pub(super) fn newton(
         ];
         let mut step = step(&j, coords(lin.c))?;
         let mut accepted = None;
-        for _ in 0..=MAX_HALVINGS {
+        for _ in 0..=stop.halvings {
             let trial = turn(&frame, a + step);
             if let Some(l) = linearise(trial)
                 && l.c.length() < lin.c.length()
@@ -204,7 +203,7 @@ pub(super) fn newton(
         let (trial, l) = accepted?;
         (a, d, lin) = (a + step, trial, l);
     }
-    (lin.c.length() < tolerance).then_some(lin)
+    (lin.c.length() < stop.tolerance).then_some(lin)
 }
 
 #[cfg(test)]

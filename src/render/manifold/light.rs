@@ -3,7 +3,7 @@
 
 use super::ManifoldSetup;
 use super::chain::Chain;
-use super::walk::{last, solve_continued};
+use super::walk::{last, solve_with_effort};
 use crate::bsdf::fresnel;
 use crate::geometry::{Ray, offset_origin};
 use crate::platelet::PlateletId;
@@ -77,13 +77,13 @@ pub fn sample_light<S: Spectral>(
     if !(u.walk < q) {
         return None;
     }
-    let c = solve_continued(
+    let c = solve_with_effort(
         world,
         (v.p, x2),
         light.normal(),
         setup.eta,
         v.chain,
-        setup.continuation,
+        setup.effort,
     )?;
     let x1 = c.exit.p;
     let u_out = (x2 - x1) / c.dist;
@@ -183,13 +183,13 @@ pub fn density(
     if !(p_pick > 0.0) {
         return 0.0;
     }
-    match solve_continued(
+    match solve_with_effort(
         world,
         (x0, x2),
         light.normal(),
         setup.eta,
         chain,
-        setup.continuation,
+        setup.effort,
     ) {
         Some(c) if c.d.dot(d) > 1.0 - SAME_DIRECTION => {
             let p = walk_probability(world, x0, x2, chain) * p_pick / (light.area() * c.jacobian);

@@ -26,10 +26,13 @@
 //! boundary stalled at the critical angle and the images of tests/platelets/manifold.rs came out
 //! 5–6 % darker than BSDF sampling's; with this one they agree within noise). Newton's method on the two tangent coordinates of `d`,
 //! seeded with the straight line `x0 → x2`, a step bounded by [`MAX_STEP`] and halved while the
-//! residual grows, at most [`MAX_ITERATIONS`] iterations; if that fails, a continuation in the
-//! index from `η = 1` ([`solve`]) — in a render only with the `manifold-continuation` knob on
-//! ([`solve_continued`]; off by default: the retries find few connections for their cost, and
-//! the MIS weight stays unbiased either way, its BSDF side running the same walk). On a cabochon, a sphere, a faceted stone or a slab the
+//! residual grows — in a render at most `manifold-halvings` times (default once: a step that a
+//! halving does not rescue has almost always crossed onto another facet or face, where halving
+//! further only creeps toward the edge; measured, docs/accuracy.md), at most
+//! [`MAX_ITERATIONS`] iterations; if that fails, a continuation in the index from `η = 1`
+//! ([`solve`]) — in a render only with the `manifold-continuation` knob on
+//! ([`solve_with_effort`]; off by default: the retries find few connections for their cost).
+//! The MIS weight stays unbiased at any effort, its BSDF side running the same walk. On a cabochon, a sphere, a faceted stone or a slab the
 //! Jacobian is exact at every iterate: the exit point's motion, the light direction's and the
 //! normal's through the surface's shape operator (`geometry::Curvature`: the domes' and the
 //! sphere's, zero on flat faces), and for a [`Chain::Through`] the entry point's and Snell's
@@ -80,8 +83,8 @@ pub use light::{
     ManifoldLight, WALK_THRESHOLD, WalkNumbers, WalkVertex, density, sample_light, transmittance,
     walk_probability,
 };
-pub use newton::{MAX_ITERATIONS, MAX_STEP, TOLERANCE};
-pub use walk::{Connection, Exit, STAGES, exit, solve, solve_by_differences, solve_continued};
+pub use newton::{MAX_HALVINGS, MAX_ITERATIONS, MAX_STEP, TOLERANCE, WalkEffort};
+pub use walk::{Connection, Exit, STAGES, exit, solve, solve_by_differences, solve_with_effort};
 
 use crate::light::Area;
 
@@ -98,22 +101,21 @@ pub struct ManifoldSetup {
     pub inside: bool,
     /// Walks from the floor through the stone ([`Chain::Through`], effect `manifold-caustics`).
     pub through: bool,
-    /// A walk that fails from the straight line retries by the continuation in the index
-    /// (the `manifold-continuation` knob; [`solve_continued`]).
-    pub continuation: bool,
+    /// How hard a walk tries (the `manifold-halvings` and `manifold-continuation` knobs;
+    /// [`solve_with_effort`]).
+    pub effort: WalkEffort,
 }
 
 impl ManifoldSetup {
     /// The setup for a smooth boundary of relative IOR `eta` (material `boundary`) and the area
-    /// lights of the scene, walking from `inside` and/or `through` the stone, with the
-    /// continuation in the index if `continuation`; `None` when no light emits or neither kind
-    /// of walk is wanted.
+    /// lights of the scene, walking from `inside` and/or `through` the stone as hard as `effort`
+    /// says; `None` when no light emits or neither kind of walk is wanted.
     pub fn new(
         eta: f32,
         boundary: u32,
         areas: &[Area],
         (inside, through): (bool, bool),
-        continuation: bool,
+        effort: WalkEffort,
     ) -> Option<ManifoldSetup> {
         if !inside && !through {
             return None;
@@ -135,7 +137,7 @@ impl ManifoldSetup {
                 .collect(),
             inside,
             through,
-            continuation,
+            effort,
         })
     }
 

@@ -11,8 +11,53 @@ pub const MAX_STEP: f32 = 0.2;
 /// The walk has converged when the refracted direction is within this angle (radians) of the
 /// direction to the light point.
 pub const TOLERANCE: f32 = 1e-5;
-/// Most halvings of one Newton step while the residual grows.
-pub const MAX_HALVINGS: u32 = 6;
+/// Most halvings of one Newton step while the residual grows that a walk may be given (the
+/// `manifold-halvings` knob's upper end).
+pub const MAX_HALVINGS: u32 = crate::scene::stage::MAX_MANIFOLD_HALVINGS;
+
+/// How hard a walk tries before it gives up: the render's `manifold-halvings` and
+/// `manifold-continuation` knobs. A walk that gives up leaves its connection to BSDF sampling,
+/// which the MIS weight's own walk (run with the same effort) accounts for, so any effort is
+/// unbiased; more effort finds more connections at more cost (docs/accuracy.md has the table).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct WalkEffort {
+    /// Most halvings of a Newton step that does not lower the residual, 0 ..= [`MAX_HALVINGS`]:
+    /// when even the shortest step fails, the walk gives up (the exact walk) or takes the
+    /// Jacobian afresh (Broyden's).
+    pub halvings: u32,
+    /// Whether a walk that fails from the straight line retries by the continuation in the
+    /// index ([`super::solve`]).
+    pub continuation: bool,
+}
+
+impl WalkEffort {
+    /// The render's default (measured, docs/accuracy.md): one halving, no continuation.
+    pub const DEFAULT: WalkEffort = WalkEffort {
+        halvings: crate::scene::stage::DEFAULT_MANIFOLD_HALVINGS,
+        continuation: false,
+    };
+    /// The most thorough walk: six halvings and the continuation ([`super::solve`]; what the
+    /// cheaper settings are measured against).
+    pub const THOROUGH: WalkEffort = WalkEffort {
+        halvings: 6,
+        continuation: true,
+    };
+}
+
+impl Default for WalkEffort {
+    fn default() -> WalkEffort {
+        WalkEffort::DEFAULT
+    }
+}
+
+/// When one Newton walk stops.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Stop {
+    /// Converged when the constraint's length is below this.
+    pub tolerance: f32,
+    /// Most halvings of a step that does not lower the constraint ([`WalkEffort::halvings`]).
+    pub halvings: u32,
+}
 
 /// `d` turned by the tangent coordinates `a` (radians, small) in `frame` (whose normal is `d`).
 #[inline]

@@ -3,7 +3,7 @@
 
 use super::chain::{Chain, Entry, entry};
 use super::exact::{self, Linearised};
-use super::newton::{MAX_HALVINGS, MAX_ITERATIONS, TOLERANCE, det, step, turn};
+use super::newton::{MAX_ITERATIONS, Stop, TOLERANCE, WalkEffort, det, step, turn};
 use crate::bsdf::refract;
 use crate::geometry::{Fan, Frame, StoneHit};
 use crate::render::world::World;
@@ -117,6 +117,8 @@ struct Problem<'a> {
     x2: Vec3,
     eta: f32,
     chain: Chain,
+    /// Most halvings of a Newton step ([`WalkEffort::halvings`]).
+    halvings: u32,
 }
 
 impl Problem<'_> {
@@ -186,7 +188,7 @@ impl Problem<'_> {
             let mut step = step(&j, r).unwrap_or(Vec2::ZERO);
             let mut accepted = None;
             if step.length() > 0.0 {
-                for _ in 0..=MAX_HALVINGS {
+                for _ in 0..=self.halvings {
                     let trial = turn(&frame, a + step);
                     if let Some((ct, _)) = self.constraint(trial)
                         && ct.length() < c.length()
@@ -277,7 +279,9 @@ const STAGE_TOLERANCE: f32 = 1e-3;
 ///
 /// Seeded with the straight line `x0 → x2`; if Newton's method fails from there, it follows the
 /// solution from `η = 1`, where the straight line is exact, through [`STAGES`] increasing indices
-/// to `eta` (a continuation: each stage starts from the last one's solution).
+/// to `eta` (a continuation: each stage starts from the last one's solution). The most thorough
+/// walk ([`WalkEffort::THOROUGH`]); a render's walks try as hard as its knobs say
+/// ([`solve_with_effort`]).
 ///
 /// # Arguments
 /// * `eta` – the boundary's IOR inside over outside.
@@ -289,26 +293,34 @@ pub fn solve(
     eta: f32,
     chain: Chain,
 ) -> Option<Connection> {
-    solve_with(world, x0, x2, n_light, eta, chain, true, true)
+    solve_with(
+        world,
+        (x0, x2),
+        n_light,
+        eta,
+        chain,
+        true,
+        WalkEffort::THOROUGH,
+    )
 }
 
-/// [`solve`], with the continuation in the index only if `continuation` (the render's
-/// `manifold-continuation` knob): without it a walk that fails from the straight line gives up.
-/// The renderer's walks, on the light side and on the BSDF side of the MIS weight alike, so the
-/// combination stays unbiased either way (a connection the walk does not find is left whole to
-/// BSDF sampling).
+/// [`solve`] with `effort`'s halvings of a Newton step, and the continuation in the index only
+/// if `effort` says so (the render's `manifold-halvings` and `manifold-continuation` knobs):
+/// the renderer's walks, on the light side and on the BSDF side of the MIS weight alike, so the
+/// combination stays unbiased at any effort (a connection the walk does not find is left whole
+/// to BSDF sampling).
 ///
 /// # Arguments
-/// As [`solve`], and `continuation` – whether to retry from `η = 1`.
-pub fn solve_continued(
+/// As [`solve`], and `effort` – how hard the walk tries.
+pub fn solve_with_effort(
     world: &World,
     (x0, x2): (Vec3, Vec3),
     n_light: Vec3,
     eta: f32,
     chain: Chain,
-    continuation: bool,
+    effort: WalkEffort,
 ) -> Option<Connection> {
-    solve_with(world, x0, x2, n_light, eta, chain, true, continuation)
+    solve_with(world, (x0, x2), n_light, eta, chain, true, effort)
 }
 
 /// [`solve`] by finite differences and Broyden's updates even where the stone knows its
@@ -324,21 +336,27 @@ pub fn solve_by_differences(
     eta: f32,
     chain: Chain,
 ) -> Option<Connection> {
-    solve_with(world, x0, x2, n_light, eta, chain, false, true)
+    solve_with(
+        world,
+        (x0, x2),
+        n_light,
+        eta,
+        chain,
+        false,
+        WalkEffort::THOROUGH,
+    )
 }
 
-/// [`solve`], with the exact Jacobian where the stone knows its curvature if `exact`, and the
-/// continuation in the index if `continuation`.
-#[allow(clippy::too_many_arguments)]
+/// [`solve`], with the exact Jacobian where the stone knows its curvature if `exact`, trying as
+/// hard as `effort` says.
 fn solve_with(
     world: &World,
-    x0: Vec3,
-    x2: Vec3,
+    (x0, x2): (Vec3, Vec3),
     n_light: Vec3,
     eta: f32,
     chain: Chain,
     exact: bool,
-    continuation: bool,
+    effort: WalkEffort,
 ) -> Option<Connection> {
     let seed = (x2 - x0).try_normalize()?;
     let problem = Problem {
@@ -347,19 +365,31 @@ fn solve_with(
         x2,
         eta,
         chain,
+        halvings: effort.halvings,
     };
     // Where the stone knows its curvature the walk takes the exact Jacobian (no finite
     // differences); elsewhere Broyden's updates.
     if exact && problem.from.has_shape_operator() {
         let stone = &world.stone;
-        let walk =
-            |p: &Problem, seed, tol| exact::newton(stone, &p.from, p.x2, p.eta, p.chain, seed, tol);
-        let lin = continued(&problem, seed, walk, |l: &Linearised| l.d, continuation)?;
+        let walk = |p: &Problem, seed, tolerance| {
+            let stop = Stop {
+                tolerance,
+                halvings: p.halvings,
+            };
+            exact::newton(stone, &p.from, (p.x2, p.eta, p.chain), seed, stop)
+        };
+        let lin = continued(
+            &problem,
+            seed,
+            walk,
+            |l: &Linearised| l.d,
+            effort.continuation,
+        )?;
         let e = exit_of(lin.hit, lin.w, eta, lin.entry())?;
         return connect(&problem, lin.d, e, n_light, Some(&lin));
     }
     let walk = |p: &Problem, seed, tol| p.newton(seed, tol);
-    let d = continued(&problem, seed, walk, |d: &Vec3| *d, continuation)?;
+    let d = continued(&problem, seed, walk, |d: &Vec3| *d, effort.continuation)?;
     let e = exit_from(world, &problem.from, d, eta, chain)?;
     connect(&problem, d, e, n_light, None)
 }

@@ -7,7 +7,7 @@ use crate::color::Rgb;
 use crate::geometry::{MediumId, Stone};
 use crate::light::Area;
 use crate::medium::Medium;
-use crate::render::manifold::ManifoldSetup;
+use crate::render::manifold::{ManifoldSetup, WalkEffort};
 use crate::scene::{Effect, Scene};
 
 /// The inside of the stone, as the world holds it.
@@ -91,7 +91,10 @@ pub(super) fn build(scene: &Scene, stone: &Stone, areas: &[Area]) -> Result<Insi
                 scene.effects.on(Effect::ManifoldNee),
                 scene.effects.on(Effect::ManifoldCaustics),
             ),
-            stage.render.manifold_continuation,
+            WalkEffort {
+                halvings: stage.render.manifold_halvings,
+                continuation: stage.render.manifold_continuation,
+            },
         ),
         _ => None,
     };
