@@ -144,6 +144,21 @@ impl FlakeMedium {
         self.flakes.iter().map(|f| Self::sigma_of(f, d)).sum()
     }
 
+    /// The largest [`sigma`](Self::sigma) over all directions, world units⁻¹ (an interpolated
+    /// projection lies between two of its table's entries).
+    pub fn sigma_max(&self) -> f32 {
+        self.flakes
+            .iter()
+            .map(|f| {
+                let e = match f.orientation {
+                    Orientation::Uniform => 0.5,
+                    Orientation::Aligned { .. } => f.projection.iter().copied().fold(0.0, f32::max),
+                };
+                f.area_density * e
+            })
+            .sum()
+    }
+
     /// The collision rate at world point `p` for unit direction `d`, world units⁻¹:
     /// `Σ σ_k(d) · m_k(p)`.
     pub fn sigma_at(&self, p: Vec3, d: Vec3) -> f32 {

@@ -104,6 +104,10 @@ pub struct ManifoldSetup {
     /// How hard a walk tries (the `manifold-halvings` and `manifold-continuation` knobs;
     /// [`solve_with_effort`]).
     pub effort: WalkEffort,
+    /// Every walk runs ([`walk_probability`] is 1 for every pair): the interior is so clear that
+    /// its optical depth over the stone's longest chord keeps the transmittance above
+    /// [`WALK_THRESHOLD`] ([`ManifoldSetup::with_clear_interior`]); false until shown.
+    pub always: bool,
 }
 
 impl ManifoldSetup {
@@ -138,7 +142,19 @@ impl ManifoldSetup {
             inside,
             through,
             effort,
+            always: false,
         })
+    }
+
+    /// Sets [`always`](Self::always) for an interior whose collision rate is at most `sigma`
+    /// (world units⁻¹, every channel and direction) in a stone whose chords are at most `chord`
+    /// long (world units): then `exp(−σ t) / WALK_THRESHOLD ≥ 1` on every straight line inside,
+    /// and the walk's probability is 1 without tracing it. The bound keeps a margin of 10⁻³ in
+    /// the optical depth for the rounding of the traced one.
+    pub fn with_clear_interior(mut self, sigma: f32, chord: f32) -> ManifoldSetup {
+        let tau = sigma * chord;
+        self.always = tau.is_finite() && tau * 1.001 + 1e-3 < (1.0 / WALK_THRESHOLD).ln();
+        self
     }
 
     /// Picks a light with `u ∈ [0, 1)`: its area-light index and probability.

@@ -130,6 +130,16 @@ pub(super) fn build(scene: &Scene, stone: &Stone, areas: &[Area]) -> Result<Insi
         }
         _ => None,
     };
+    // The walks' probability is 1 everywhere in a clear enough interior (no line traced for it).
+    let manifold = manifold.map(|m| {
+        let sigma = if medium_on {
+            media[usize::from(interior.0)].min_extinction()
+        } else {
+            0.0
+        } + flakes.as_ref().map_or(0.0, |f| f.sigma_max());
+        let (lo, hi) = stone.bounds();
+        m.with_clear_interior(sigma, (hi - lo).length())
+    });
     Ok(Inside {
         media,
         interior,
