@@ -263,6 +263,7 @@ fn info_names_the_body_and_the_recipe_line_that_turned_transmission_and_medium_o
             medium.as_str(),
             "Body ",
             "body: IOR ",
+            "manifold walks: halvings per step 1, continuation off",
         ] {
             assert!(
                 text.contains(expected),

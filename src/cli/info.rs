@@ -367,7 +367,7 @@ pub fn describe(recipe: &GemRecipe, scene: &Scene, points: u32) -> String {
     if scene.surface.body.is_some() {
         let _ = writeln!(
             o,
-            "  medium       depth {}, scattering {}; manifold walks halve a step at most {} times, retry by continuation: {}",
+            "  medium       depth {}, scattering {}; manifold walks: halvings per step {}, continuation {}",
             r.medium_depth,
             if r.medium_scattering {
                 "on"
