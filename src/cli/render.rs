@@ -68,8 +68,7 @@ pub struct RenderArgs {
     /// in the index (default: the recipe's, else off).
     #[arg(long, value_parser = super::knobs::switch_arg)]
     pub manifold_continuation: Option<bool>,
-    /// Most halvings of a manifold walk's Newton step that does not lower the residual before
-    /// the walk gives up (default: the recipe's, else 1)
+    /// Most halvings of a failing manifold walk step before it gives up (default: recipe's, else 1)
     #[arg(long, value_parser = clap::value_parser!(u32).range(0..=8))]
     pub manifold_halvings: Option<u32>,
     /// Stop after this many seconds, setup included, and write what was rendered (marked

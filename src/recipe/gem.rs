@@ -53,7 +53,7 @@ use std::path::{Path, PathBuf};
 #[serde(deny_unknown_fields)]
 pub struct GemDesc {
     /// Recipe seed (default 0): every default Voronoi and noise seed derives from it.
-    #[serde(default, deserialize_with = "super::stage::any_seed")]
+    #[serde(default, deserialize_with = "super::ranged::any_seed")]
     pub seed: u64,
     /// Material libraries whose materials the tree may use, relative to this file.
     #[serde(default, deserialize_with = "super::ranged::includes")]

@@ -26,6 +26,7 @@ pub mod material;
 mod platelet_compiler;
 pub mod platelets;
 pub mod pleochroism;
+pub mod render_desc;
 mod resolve;
 mod shape;
 pub mod source;

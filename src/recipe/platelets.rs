@@ -115,7 +115,7 @@ pub struct PlateletsDesc {
     pub entries: Vec<EntryDesc>,
     /// Seed of the point process (default: derived from the recipe seed and the population's
     /// position).
-    #[serde(default, deserialize_with = "super::stage::seed_range")]
+    #[serde(default, deserialize_with = "super::ranged::seed_range")]
     pub seed: Option<u64>,
     /// Density modulation: a field over object space whose value, clamped to `0 ..= 1`
     /// (dimensionless), multiplies `density` at each point (default: none, uniform density).

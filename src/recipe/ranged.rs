@@ -403,6 +403,28 @@ pub(crate) fn positive2<'de, D: serde::Deserializer<'de>>(d: D) -> Result<(f32, 
     sizes_ok(&mut s, v).map(|()| (s[0], s[1]))
 }
 
+/// A `u32` count in `lo ..= hi`; any number is read, so an overflowing literal still gets the
+/// field's name and range.
+pub(crate) fn count<'de, D: serde::Deserializer<'de>>(
+    d: D,
+    name: &'static str,
+    lo: u32,
+    hi: u32,
+) -> Result<Option<u32>, D::Error> {
+    let v = whole(d, name, lo.into(), hi.into())?;
+    Ok(Some(v as u32)) // within `hi`, a u32
+}
+
+/// A seed field (`Option`): any `u64`, with the field's name and range when the literal is not
+/// one.
+pub(crate) fn seed_range<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<u64>, D::Error> {
+    any_seed(d).map(Some)
+}
+/// A seed: any `u64`, with the field's name and range when the literal is not one.
+pub(crate) fn any_seed<'de, D: serde::Deserializer<'de>>(d: D) -> Result<u64, D::Error> {
+    whole(d, "seed", 0, u64::MAX)
+}
+
 #[cfg(test)]
 mod tests {
     use super::super::surface::{FieldDesc, MapDesc, SwitchDesc};

@@ -172,7 +172,7 @@ pub enum MapDesc {
         #[serde(default = "one", deserialize_with = "jitter_range")]
         jitter: f32,
         /// Seed; default: derived from the recipe seed and the node's position in the file.
-        #[serde(default, deserialize_with = "super::stage::seed_range")]
+        #[serde(default, deserialize_with = "super::ranged::seed_range")]
         seed: Option<u64>,
         /// `(weight, node)` pairs (1 ..= 100 000); each filled cell picks one with probability ∝
         /// weight.
@@ -334,7 +334,7 @@ pub enum FieldDesc {
         #[serde(default = "two", deserialize_with = "lacunarity_range")]
         lacunarity: f32,
         /// Seed; default derived like a Voronoi's.
-        #[serde(default, deserialize_with = "super::stage::seed_range")]
+        #[serde(default, deserialize_with = "super::ranged::seed_range")]
         seed: Option<u64>,
     },
     /// Turbulence `Σ gainᵏ |noise|`, 0 … 1.
@@ -352,7 +352,7 @@ pub enum FieldDesc {
         #[serde(default = "two", deserialize_with = "lacunarity_range")]
         lacunarity: f32,
         /// Seed.
-        #[serde(default, deserialize_with = "super::stage::seed_range")]
+        #[serde(default, deserialize_with = "super::ranged::seed_range")]
         seed: Option<u64>,
     },
     /// Marble veins, 0 … 1: `½ + ½ sin(2π(axis·p/scale + turbulence·turb(p/scale)))`.
@@ -376,7 +376,7 @@ pub enum FieldDesc {
         #[serde(default = "two", deserialize_with = "lacunarity_range")]
         lacunarity: f32,
         /// Seed.
-        #[serde(default, deserialize_with = "super::stage::seed_range")]
+        #[serde(default, deserialize_with = "super::ranged::seed_range")]
         seed: Option<u64>,
     },
     /// Sum of fields (1 ..= 64 inputs).
