@@ -11,6 +11,7 @@
 //! The choice between the two rectangle strategies depends only on the shading point, so
 //! [`Area::pdf`] always reproduces the density [`Area::sample`] used.
 
+use super::outline::{Beam, Outline};
 use super::spherical_rect::SphericalRect;
 use super::{LightSample, positive_or_zero};
 use crate::color::Rgb;
@@ -26,29 +27,6 @@ use std::f32::consts::PI;
 /// Relative slack on the outline when [`Area::pdf`] re-intersects a direction, so a sample on the
 /// very edge still finds the light after rounding.
 const EDGE_SLACK: f32 = 1e-4;
-
-/// The outline in the light's own frame.
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum Outline {
-    /// Half-extents along `frame.s` and `frame.t`.
-    Rect { hx: f32, hy: f32 },
-    /// Radius around the centre.
-    Disc { radius: f32 },
-}
-
-impl Outline {
-    /// Whether the point `(a, b)` of the light's plane (coordinates along `frame.s`, `frame.t`
-    /// from the centre) lies on the light, its outline grown by the relative `slack`.
-    #[inline(always)]
-    fn contains(&self, a: f32, b: f32, slack: f32) -> bool {
-        match *self {
-            Outline::Rect { hx, hy } => {
-                a.abs() <= hx * (1.0 + slack) && b.abs() <= hy * (1.0 + slack)
-            }
-            Outline::Disc { radius } => a * a + b * b <= (radius * (1.0 + slack)).powi(2),
-        }
-    }
-}
 
 /// A planar emitter with uniform radiance, built from a stage [`AreaLight`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -67,33 +45,6 @@ pub struct Area {
     beam: Option<Beam>,
     /// The polariser's transmission axis, if any ([`Area::polariser`]).
     polariser: Option<Vec3>,
-}
-
-/// The cone of a beam of half-angle `θ`, kept as `sin² θ` and `tan θ` (computed in `f64` from the
-/// angle): near the axis `cos θ` rounds to within an ulp of 1, while `|w × n|² ≤ sin² θ` resolves a
-/// 0.3° cone to 1e-7 of its width.
-#[derive(Clone, Copy, Debug, PartialEq)]
-struct Beam {
-    sin2: f32,
-    tan: f32,
-}
-
-impl Beam {
-    fn new(half_angle: f32) -> Beam {
-        let t = f64::from(half_angle.clamp(0.0, 1.5));
-        Beam {
-            sin2: t.sin().powi(2) as f32,
-            tan: t.tan() as f32,
-        }
-    }
-
-    /// Whether the unit direction `w` (leaving the light) lies in the cone about `n`, with a
-    /// relative slack of 1e-5 on `sin² θ`, so that the footprint's rim, sampled by
-    /// [`Strategy::Beam`], is inside after rounding.
-    #[inline]
-    fn admits(&self, w: Vec3, n: Vec3) -> bool {
-        w.dot(n) > 0.0 && w.cross(n).length_squared() <= self.sin2 * (1.0 + 1e-5)
-    }
 }
 
 /// How directions toward a light are drawn from a given point.

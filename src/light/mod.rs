@@ -15,6 +15,7 @@
 pub mod area;
 pub mod distribution;
 pub mod environment;
+mod outline;
 mod spherical_rect;
 
 pub use area::Area;
