@@ -18,7 +18,8 @@ pub const MAX_HALVINGS: u32 = crate::scene::stage::MAX_MANIFOLD_HALVINGS;
 /// How hard a walk tries before it gives up: the render's `manifold-halvings` and
 /// `manifold-continuation` knobs. A walk that gives up leaves its connection to BSDF sampling,
 /// which the MIS weight's own walk (run with the same effort) accounts for, so any effort is
-/// unbiased; more effort finds more connections at more cost (docs/accuracy.md has the table).
+/// unbiased; more effort finds more connections at more cost (docs/accuracy.md has the table;
+/// a render's default is its settings', `crate::scene::stage::DEFAULT_MANIFOLD_HALVINGS`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct WalkEffort {
     /// Most halvings of a Newton step that does not lower the residual, 0 ..= [`MAX_HALVINGS`]:
@@ -31,23 +32,12 @@ pub struct WalkEffort {
 }
 
 impl WalkEffort {
-    /// The render's default (measured, docs/accuracy.md): one halving, no continuation.
-    pub const DEFAULT: WalkEffort = WalkEffort {
-        halvings: crate::scene::stage::DEFAULT_MANIFOLD_HALVINGS,
-        continuation: false,
-    };
     /// The most thorough walk: six halvings and the continuation ([`super::solve`]; what the
     /// cheaper settings are measured against).
     pub const THOROUGH: WalkEffort = WalkEffort {
         halvings: 6,
         continuation: true,
     };
-}
-
-impl Default for WalkEffort {
-    fn default() -> WalkEffort {
-        WalkEffort::DEFAULT
-    }
 }
 
 /// When one Newton walk stops.
