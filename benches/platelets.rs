@@ -11,7 +11,9 @@
 //!   passed).
 //!
 //! Populations: `aventurine-glass` (8 000 / unit³, r 0.01–0.04, uniform orientation) and
-//! `oregon-sunstone` (800 / unit³, r 0.015–0.04, aligned to y with a 4° spread). Times are the
+//! `oregon-sunstone` (800 / unit³, r 0.015–0.04, aligned to y with a 4° spread), each drawn cell
+//! by cell as the walk goes and (`…-table`) from the lists a render prepares over the stone's box
+//! (`Population::prepare`). Times are the
 //! benchmark thread's CPU time on 64-bit Linux (wall time elsewhere). Run with
 //! `cargo bench --bench platelets` (about 40 s); a filter narrows it, e.g.
 //! `cargo bench --bench platelets -- aventurine/first`.
@@ -144,7 +146,16 @@ fn walks(c: &mut Criterion<Clock>) {
 fn bench(c: &mut Criterion<Clock>) {
     walks(c);
     let rays = chords(0x18);
+    let mut cases = Vec::new();
     for (name, pop) in populations() {
+        // The same population with its cells drawn once over the stone's box (what a render
+        // walks: the lists of `platelet::table`).
+        let mut table = pop.clone();
+        table.prepare(Vec3::splat(-1.0), Vec3::splat(1.0));
+        cases.push((name.to_string(), pop));
+        cases.push((format!("{name}-table"), table));
+    }
+    for (name, pop) in cases {
         let pops = std::slice::from_ref(&pop);
         let mut group = c.benchmark_group(format!("platelets/{name}"));
         group.throughput(Throughput::Elements(RAYS as u64));

@@ -80,6 +80,17 @@ impl Homogeneous {
         transmittance(sigma_t, t)
     }
 
+    /// See [`super::Medium::collision`].
+    #[inline]
+    pub fn collision<S: Spectral>(&self, hero: usize, u: f32, lambda: &S::Wavelengths) -> f32 {
+        if !self.scatters() {
+            return f32::INFINITY;
+        }
+        let sigma_t = coefficient::<S>(self.sigma_a, self.sigma_a_measured, lambda)
+            + coefficient::<S>(self.sigma_s, self.sigma_s_measured, lambda);
+        distance(sigma_t.channel(hero), u)
+    }
+
     /// See [`super::Medium::free_flight`].
     #[inline]
     pub fn free_flight<S: Spectral>(
@@ -99,12 +110,7 @@ impl Homogeneous {
         }
         let sigma_s = coefficient::<S>(self.sigma_s, self.sigma_s_measured, lambda);
         let sigma_t = sigma_a + sigma_s;
-        let st = sigma_t.channel(hero);
-        let t = if st > 0.0 {
-            -(1.0 - u).ln() / st
-        } else {
-            f32::INFINITY
-        };
+        let t = distance(sigma_t.channel(hero), u);
         if t < t_max {
             let tr = transmittance(sigma_t, t);
             FreeFlight::Scatter {
@@ -116,6 +122,17 @@ impl Homogeneous {
             let tr = transmittance(sigma_t, t_max);
             FreeFlight::Pass { value: tr, pdf: tr }
         }
+    }
+}
+
+/// The free-flight distance `−ln(1 − u) / σt` (world units) for the hero channel's extinction
+/// `st` (endless where `st ≤ 0`): inversion of the exponential distribution (pbrt-v4 §11.2.2).
+#[inline]
+fn distance(st: f32, u: f32) -> f32 {
+    if st > 0.0 {
+        -(1.0 - u).ln() / st
+    } else {
+        f32::INFINITY
     }
 }
 
@@ -233,5 +250,33 @@ mod tests {
         for c in 0..3 {
             assert!((rgb.0[c] - (-m.to_rgb()[c] * t).exp()).abs() < 1e-6);
         }
+    }
+
+    /// `collision` is the distance at which `free_flight` scatters: the same bits for a segment
+    /// longer than it, a pass for one that ends at or before it, and endless without scattering.
+    #[test]
+    fn the_collision_is_where_the_free_flight_scatters() {
+        let m = medium([0.3, 0.5, 0.9], [2.0, 1.5, 0.7]);
+        let lambda = RgbWavelengths;
+        let mut scattered = 0;
+        for i in 0..3000 {
+            let u = (i as f32 + 0.5) / 3000.0;
+            let hero = i % 3;
+            let t = m.collision::<RgbSample>(hero, u, &lambda);
+            assert!(t.is_finite() && t > 0.0, "{u}: {t}");
+            for t_max in [t * 0.5, t, f32::INFINITY, 1.0] {
+                match m.free_flight::<RgbSample>(t_max, hero, u, &lambda) {
+                    FreeFlight::Scatter { t: s, .. } => {
+                        assert_eq!(s.to_bits(), t.to_bits());
+                        assert!(t < t_max);
+                        scattered += 1;
+                    }
+                    FreeFlight::Pass { .. } => assert!(t >= t_max, "{u}: {t} < {t_max}"),
+                }
+            }
+        }
+        assert!(scattered > 3000, "{scattered}");
+        let clear = medium([0.3, 0.5, 0.9], [0.0; 3]);
+        assert_eq!(clear.collision::<RgbSample>(0, 0.5, &lambda), f32::INFINITY);
     }
 }

@@ -92,6 +92,17 @@ impl Medium {
         }
     }
 
+    /// The distance (world units) at which [`free_flight`](Self::free_flight) with the same `hero`,
+    /// `u` and `lambda` scatters when the segment is longer; `f32::INFINITY` where the medium
+    /// cannot scatter. A surface beyond it is never met first.
+    #[inline]
+    pub fn collision<S: Spectral>(&self, hero: usize, u: f32, lambda: &S::Wavelengths) -> f32 {
+        match self {
+            Medium::Vacuum => f32::INFINITY,
+            Medium::Homogeneous(h) => h.collision::<S>(hero, u, lambda),
+        }
+    }
+
     /// The transmittance `e^(−σt t)` per channel over `t` world units (a shadow segment; 1 in a
     /// vacuum).
     #[inline]

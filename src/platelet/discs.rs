@@ -94,8 +94,9 @@ pub(super) fn test_cell(
 }
 
 /// Tests the discs of a cell's list in `table` (the cell's lowest corner at `corner`) against the
-/// segment, keeping the best hit in `best`: the bounding spheres four at once, then each disc
-/// whose sphere meets the segment as [`test_cell`] does.
+/// segment, keeping the best hit in `best`: four discs at once, each with [`Test::disc`]'s
+/// operations — the bounding sphere, then [`hit_disc`]'s plane test with the normal the table
+/// drew — lane by lane the same numbers, so the same hits as [`test_cell`].
 #[inline]
 pub(super) fn test_list(
     pop: &Population,
@@ -107,17 +108,12 @@ pub(super) fn test_list(
     best: &mut Option<PlateletHit>,
 ) {
     let margin = margin(pop, corner, slack);
-    let test = Test {
-        pop,
-        ray,
-        margin,
-        reach_max: pop.radius.1 + margin,
-    };
     let (o, d) = (ray.o, ray.d);
     let t_min = Vec4::splat(ray.t_min);
+    let tiny = Vec4::splat(1e-12);
     for q in quads {
         let hi = Vec4::splat(best.map_or(ray.t_max, |h| h.t));
-        // `Test::disc`'s bounding sphere, four at once (a NaN `tc` is clamped to `t_min`).
+        // `Test::disc`'s bounding sphere (a NaN `tc` is clamped to `t_min`).
         let (wx, wy, wz) = (q.x - o.x, q.y - o.y, q.z - o.z);
         let tc = (wx * d.x + wy * d.y + wz * d.z) * ray.inv_dd;
         let tc = Vec4::select(tc.cmpge(t_min), tc, t_min);
@@ -125,18 +121,47 @@ pub(super) fn test_list(
         let (ex, ey, ez) = (wx - tc * d.x, wy - tc * d.y, wz - tc * d.z);
         let reach = q.r + margin;
         // A NaN radius (an unused place) fails.
-        let mut near = (ex * ex + ey * ey + ez * ez).cmple(reach * reach).bitmask();
-        while near != 0 {
-            let lane = near.trailing_zeros() as usize;
-            near &= near - 1;
+        let near = (ex * ex + ey * ey + ez * ez).cmple(reach * reach);
+        // Most groups have no disc near the segment.
+        if !near.any() {
+            continue;
+        }
+        // `hit_disc`: the plane (an unused place's zero normal fails) and the disc.
+        let dn = d.x * q.nx + d.y * q.ny + d.z * q.nz;
+        let t = (wx * q.nx + wy * q.ny + wz * q.nz) / dn;
+        let (qx, qy, qz) = (
+            (o.x + d.x * t) - q.x,
+            (o.y + d.y * t) - q.y,
+            (o.z + d.z * t) - q.z,
+        );
+        let inside = (qx * qx + qy * qy + qz * qz).cmple(q.r * q.r);
+        let hit = near & dn.abs().cmpge(tiny) & t.cmpgt(t_min) & t.cmple(hi) & inside;
+        let mut lanes = hit.bitmask();
+        while lanes != 0 {
+            let lane = lanes.trailing_zeros() as usize;
+            lanes &= lanes - 1;
             let drawn = table.drawn(q.disc[lane]);
-            let skipped = ray.skip.is_some_and(|s| {
-                s.population == ray.index && s.cell == drawn.cell && s.index == drawn.index
-            });
-            if !skipped {
-                let center = Vec3::new(q.x[lane], q.y[lane], q.z[lane]);
-                let rest = || drawn.rest.clone();
-                test.disc(drawn.cell, drawn.index, center, || q.r[lane], rest, best);
+            let id = PlateletId {
+                population: ray.index,
+                cell: drawn.cell,
+                index: drawn.index,
+            };
+            if ray.skip == Some(id) || !beats(t[lane], id, best) {
+                continue;
+            }
+            let platelet = Platelet {
+                center: Vec3::new(q.x[lane], q.y[lane], q.z[lane]),
+                normal: drawn.normal,
+                radius: q.r[lane],
+                material: drawn.material,
+            };
+            if pop.kept(drawn.cell, drawn.index, &platelet) {
+                *best = Some(PlateletHit {
+                    t: t[lane],
+                    normal: drawn.normal,
+                    material: drawn.material,
+                    id,
+                });
             }
         }
     }

@@ -312,7 +312,8 @@ mod tests {
 
     /// The cells drawn once ([`Population::prepare`]) change no hit: the walk of a prepared
     /// population and of the same population unprepared return the same hit, bit for bit, for
-    /// 4000 segments inside, across and outside the table's box (plain and thinned populations).
+    /// 4000 segments inside, across and outside the table's box (plain and thinned populations),
+    /// and each segment again from its hit on, skipping the disc it leaves.
     #[test]
     fn a_prepared_population_walks_as_an_unprepared_one() {
         use crate::texture::{FieldNode, FieldTable};
@@ -352,6 +353,17 @@ mod tests {
                 assert_eq!(a.map(|h| h.normal), b.map(|h| h.normal));
                 assert_eq!(a.map(|h| h.material), b.map(|h| h.material));
                 hits += usize::from(a.is_some());
+                // On from the hit point, skipping the disc it leaves (which lies at t ≈ 0).
+                if let Some(h) = a {
+                    let from = o + d * h.t;
+                    let again = |p: &Population| {
+                        intersect(std::slice::from_ref(p), from, d, 0.0, t_max, Some(h.id))
+                            .map(|h| (h.t.to_bits(), h.id, h.normal.to_array(), h.material))
+                    };
+                    let next = again(&prepared);
+                    assert_eq!(next, again(&unprepared));
+                    assert!(next.is_none_or(|n| n.1 != h.id));
+                }
             }
             assert!(hits > 400, "the test needs hits: {hits}");
         }

@@ -13,22 +13,21 @@
 //! walked by drawing as before).
 //!
 //! A list stores its discs four by four, each coordinate of a group in one [`Vec4`] ([`Quad`]), so
-//! the walk tests four bounding spheres at once (a group's unused places have a NaN radius, which
-//! no test accepts), and each disc's cell, index and its stream's state before its normal: the
-//! walk draws the normal and material only for the discs whose bounding sphere meets its segment,
-//! as it does without the table.
+//! the walk tests four discs at once (a group's unused places have a NaN radius and a zero normal,
+//! which no test accepts). The table draws each disc's normal and material once, from the disc's
+//! own stream as the walk would: the walk meets each disc's plane four at a time instead of
+//! drawing a normal for every disc whose bounding sphere meets its segment.
 //!
 //! The table is a cache: it changes no result, only where the walk reads the numbers. It is
 //! bounded ([`MAX_CELLS`], [`MAX_ENTRIES`]); a stone whose box needs more is walked without it.
 
 use super::Population;
-use crate::sampler::Rng;
 use glam::{Vec3, Vec4};
 use std::sync::Arc;
 
 /// Most cells one table lists.
 pub const MAX_CELLS: u64 = 1 << 20;
-/// Most places (four per [`Quad`]) in one table's lists: 20 bytes each, plus 24 per disc drawn.
+/// Most places (four per [`Quad`]) in one table's lists: 32 bytes each, plus 32 per disc drawn.
 pub const MAX_ENTRIES: u64 = 1 << 20;
 
 /// Four discs of a cell's list (module docs): centres, radii and where each one was drawn.
@@ -42,20 +41,28 @@ pub(crate) struct Quad {
     pub z: Vec4,
     /// Radii, object units (NaN for an unused place).
     pub r: Vec4,
+    /// Unit normals' `x` (0 for an unused place).
+    pub nx: Vec4,
+    /// Unit normals' `y`.
+    pub ny: Vec4,
+    /// Unit normals' `z`.
+    pub nz: Vec4,
     /// Each disc's place in [`CellTable::drawn`].
     pub disc: [u32; 4],
 }
 
-/// Where a disc was drawn: its cell, its index there, and the cell's stream positioned at its
-/// normal ([`super::CellStream::rest`]).
+/// Where a disc was drawn (its cell and its index there) and what its stream drew after its
+/// centre ([`super::CellStream::finish`]): its normal and material.
 #[derive(Clone, Debug)]
 pub(crate) struct Drawn {
     /// The disc's cell.
     pub cell: [i32; 3],
     /// Its index in the cell.
     pub index: u32,
-    /// The stream its normal and material are drawn from.
-    pub rest: Rng,
+    /// Its unit normal, object space.
+    pub normal: Vec3,
+    /// Its material index.
+    pub material: u32,
 }
 
 /// The lists of a box of cells of one population (module docs).
@@ -162,7 +169,7 @@ pub fn draw(pop: &Population, lo: Vec3, hi: Vec3) -> Option<CellTable> {
     // Every disc of the drawn cells, and where each cell's begin.
     let mut drawn = Vec::new();
     let mut drawn_start = Vec::with_capacity(drawn_cells as usize + 1);
-    let mut centres: Vec<(Vec3, f32)> = Vec::new();
+    let mut centres: Vec<(Vec3, f32, Vec3)> = Vec::new();
     for x in 0..n0 {
         for y in 0..n1 {
             for z in 0..n2 {
@@ -170,12 +177,16 @@ pub fn draw(pop: &Population, lo: Vec3, hi: Vec3) -> Option<CellTable> {
                 let cell = [first[0] - 1 + x, first[1] - 1 + y, first[2] - 1 + z];
                 let mut stream = pop.stream(cell);
                 while let Some((index, center, radius)) = stream.next_disc() {
+                    let Some((normal, material)) = stream.finish() else {
+                        break;
+                    };
                     drawn.push(Drawn {
                         cell,
                         index,
-                        rest: stream.rest(),
+                        normal,
+                        material,
                     });
-                    centres.push((center, radius));
+                    centres.push((center, radius, normal));
                 }
             }
         }
@@ -191,6 +202,9 @@ pub fn draw(pop: &Population, lo: Vec3, hi: Vec3) -> Option<CellTable> {
         y: Vec4::ZERO,
         z: Vec4::ZERO,
         r: Vec4::NAN,
+        nx: Vec4::ZERO,
+        ny: Vec4::ZERO,
+        nz: Vec4::ZERO,
         disc: [0; 4],
     };
     for x in 0..size[0] as i32 {
@@ -207,7 +221,7 @@ pub fn draw(pop: &Population, lo: Vec3, hi: Vec3) -> Option<CellTable> {
                         for dz in 0..3 {
                             let i = (((x + dx) * n1 + y + dy) * n2 + z + dz) as usize;
                             for k in drawn_start[i]..drawn_start[i + 1] {
-                                let (center, radius) = centres[k as usize];
+                                let (center, radius, normal) = centres[k as usize];
                                 // Distance from the centre to the cell's box.
                                 let gap = (low - center).max(center - high).max(Vec3::ZERO);
                                 let reach = radius + margin;
@@ -223,6 +237,9 @@ pub fn draw(pop: &Population, lo: Vec3, hi: Vec3) -> Option<CellTable> {
                                     q.y[lane] = center.y;
                                     q.z[lane] = center.z;
                                     q.r[lane] = radius;
+                                    q.nx[lane] = normal.x;
+                                    q.ny[lane] = normal.y;
+                                    q.nz[lane] = normal.z;
                                     q.disc[lane] = k;
                                 }
                                 lane += 1;

@@ -135,10 +135,27 @@ where
         // boundary: a ray inside the body that meets no boundary is outside the stone by rounding,
         // where the population's discs are not part of it).
         let mut hidden: Option<Hit> = None;
+        // The medium's numbers for this segment (slot-addressed: drawing them first changes
+        // nothing) and, without statistical flakes, its sampled collision: a platelet beyond it
+        // is never met first (the free flight below scatters before it either way), so the grid
+        // walk stops there.
+        let flight = world.medium.then(|| {
+            let u = sampler.get2d_at(slots::medium(path.depth));
+            let hero = *path
+                .hero
+                .get_or_insert(((u.x * S::CHANNELS as f32) as usize).min(S::CHANNELS - 1));
+            (u, hero)
+        });
+        let collision = match flight {
+            Some((u, hero)) if world.flakes.is_none() && !world.platelets.is_empty() => {
+                world.media[usize::from(path.medium.0)].collision::<S>(hero, u.y, &path.lambda)
+            }
+            _ => f32::INFINITY,
+        };
         if !world.platelets.is_empty()
             && path.medium == world.interior
             && let Some(t_max) = found.as_ref().map(Hit::t)
-            && let Some(h) = world.platelet_hit(&ray, t_max, path.platelet)
+            && let Some(h) = world.platelet_hit(&ray, t_max.min(collision), path.platelet)
         {
             hidden = found.replace(h);
         }
@@ -165,13 +182,9 @@ where
         let pleochroic = POL
             .then(|| pleochroic_segment(world, path.medium, sampler))
             .flatten();
-        if world.medium {
+        if let Some((u, hero)) = flight {
             let medium = &world.media[usize::from(path.medium.0)];
             let t_hit = found.as_ref().map_or(f32::INFINITY, Hit::t);
-            let u = sampler.get2d_at(slots::medium(path.depth));
-            let hero = *path
-                .hero
-                .get_or_insert(((u.x * S::CHANNELS as f32) as usize).min(S::CHANNELS - 1));
             match medium.free_flight::<S>(t_hit, hero, u.y, &path.lambda) {
                 FreeFlight::Pass { value, pdf } => path.take_flight(hero, value, pdf),
                 FreeFlight::Scatter { t, value, pdf } => {
