@@ -17,7 +17,7 @@ use super::placed::PlacedCabochon;
 use super::ray::Ray;
 use super::solid::Solid;
 use super::stone::{Stone, StoneHit};
-use glam::{Mat3A, Vec3};
+use glam::{Mat3A, Vec3, Vec3A};
 
 /// How a [`Fan`] meets the stone.
 #[derive(Clone, Copy, Debug)]
@@ -275,6 +275,12 @@ impl Curvature {
     /// `δn = S δx` at the hit whose unit normal is `n`.
     #[inline]
     pub fn turn(&self, n: Vec3, dx: Vec3) -> Vec3 {
+        self.turn_a(n.into(), dx.into()).into()
+    }
+
+    /// [`Curvature::turn`] on [`Vec3A`]s (the same operations, so the same bits).
+    #[inline]
+    pub fn turn_a(&self, n: Vec3A, dx: Vec3A) -> Vec3A {
         let w = self.field * dx;
         (w - n * n.dot(w)) * self.inv_len
     }

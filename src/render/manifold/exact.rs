@@ -6,7 +6,7 @@
 use super::chain::{Chain, Entry, entry_at};
 use super::newton::{MAX_ITERATIONS, Stop, step, turn};
 use crate::geometry::{Curvature, CurvedHit, Fan, Frame, Stone, StoneHit};
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec3A};
 
 /// The constraint at a direction with what its derivative needs ([`linearise`]).
 #[derive(Clone, Copy)]
@@ -58,28 +58,33 @@ impl Linearised {
         self.front.map(|f| f.entry)
     }
 
-    /// `∂C/∂d · δd` (world; [`linearise`]).
+    /// `∂C/∂d · δd` (world; [`linearise`]). Computed in [`Vec3A`]s (one SSE operation per
+    /// vector operation): the same IEEE operations in the same order as on [`Vec3`]s — a dot
+    /// product is `(x·x' + y·y') + z·z'` either way — so the same bits.
     #[inline]
     pub fn derivative(&self, dd: Vec3) -> Vec3 {
-        let n = self.hit.ns;
+        let a = Vec3A::from;
+        let (dd, n, w) = (a(dd), a(self.hit.ns), a(self.w));
         let (dx, dw) = match &self.front {
-            None => ((dd - self.w * (n.dot(dd) / self.cos)) * self.hit.t, dd),
+            None => ((dd - w * (n.dot(dd) / self.cos)) * self.hit.t, dd),
             Some(f) => {
                 // The entry point slides on the surface, its normal turns, and Snell's law
                 // `w = r d + (r cos θi − cos θt) nₑ` (r = 1/η) moves the direction inside.
-                let dp = (dd + f.d * (f.n.dot(dd) / f.cos_i)) * f.entry.t;
-                let dne = f.curvature.turn(f.n, dp);
+                let (fd, fn_) = (a(f.d), a(f.n));
+                let dp = (dd + fd * (fn_.dot(dd) / f.cos_i)) * f.entry.t;
+                let dne = f.curvature.turn_a(fn_, dp);
                 let r = self.eta.recip();
-                let dci = -(dd.dot(f.n) + f.d.dot(dne));
+                let dci = -(dd.dot(fn_) + fd.dot(dne));
                 let dct = r * r * f.cos_i * dci / f.cos_t;
-                let dw = dd * r + f.n * (r * dci - dct) + dne * (r * f.cos_i - f.cos_t);
+                let dw = dd * r + fn_ * (r * dci - dct) + dne * (r * f.cos_i - f.cos_t);
                 let q = dp + dw * self.hit.t;
-                (q - self.w * (n.dot(q) / self.cos), dw)
+                (q - w * (n.dot(q) / self.cos), dw)
             }
         };
-        let dn = self.curvature.turn(n, dx);
-        let dv = dw * self.eta + (dx - self.u * self.u.dot(dx)) * self.inv_len;
-        dv - n * n.dot(dv) - dn * self.vn - n * self.v.dot(dn)
+        let (u, v) = (a(self.u), a(self.v));
+        let dn = self.curvature.turn_a(n, dx);
+        let dv = dw * self.eta + (dx - u * u.dot(dx)) * self.inv_len;
+        (dv - n * n.dot(dv) - dn * self.vn - n * v.dot(dn)).into()
     }
 }
 
