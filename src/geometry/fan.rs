@@ -149,7 +149,8 @@ impl<'a> Fan<'a> {
     #[inline]
     fn sphere_curvature(&self, radius: f32, hit: &StoneHit) -> Option<Curvature> {
         let nw = self.stone.normal_to_world();
-        let field = nw * self.stone.to_object().matrix3 * radius.recip();
+        // Formed once with the stone (the same product, so the same bits).
+        let field = self.stone.sphere_field()?;
         let inv_len = (nw * (hit.p_object / radius)).length().recip();
         inv_len.is_finite().then_some(Curvature { field, inv_len })
     }

@@ -34,6 +34,9 @@ pub struct Stone {
     /// A cabochon met in its world-placed normalised frames (module `fan`); `None` for the
     /// other solids.
     placed: Option<PlacedCabochon>,
+    /// A sphere's shape-operator field `F = N A⁻¹ / r` (module `fan`), formed once; `None` for
+    /// the other solids.
+    sphere_field: Option<Mat3A>,
 }
 
 impl Stone {
@@ -54,8 +57,13 @@ impl Stone {
             return Err(GeometryError::Transform);
         }
         let normal_to_world = to_object.matrix3.transpose();
+        let sphere_field = match &solid {
+            Solid::Sphere(s) => Some(normal_to_world * to_object.matrix3 * s.radius().recip()),
+            _ => None,
+        };
         Ok(Stone {
             placed: placed(&solid, to_object, normal_to_world),
+            sphere_field,
             solid,
             to_world,
             to_object,
@@ -82,6 +90,11 @@ impl Stone {
     /// World → object transform.
     pub fn to_object(&self) -> Affine3A {
         self.to_object
+    }
+
+    /// A sphere's field `N A⁻¹ / r` ([`crate::geometry::Curvature`]), if the solid is one.
+    pub(crate) fn sphere_field(&self) -> Option<Mat3A> {
+        self.sphere_field
     }
 
     /// The placed cabochon, if the solid is one.
