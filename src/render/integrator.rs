@@ -70,6 +70,7 @@ use super::manifold;
 use super::manifold::{Chain, WalkNumbers, WalkVertex};
 use super::path::{ManifoldVertex, PathSample, PathState, keep_off_the_boundary};
 use super::polarised::{StokesAov, crystal_boundary, crystal_sample, polarise, stokes_add};
+use super::segment::{Meeting, medium_vertex_light, meet};
 use super::shading::shade;
 use super::world::{Hit, LightRef, World};
 use crate::bsdf::{Bsdf, Scatter};
@@ -131,53 +132,7 @@ where
         sampler.skip_to(slots::bounce(path.depth));
         out.rays += 1;
         let mut found = world.intersect(&ray, f32::INFINITY);
-        // The boundary ahead when a platelet hides it (platelets are walked only up to the
-        // boundary: a ray inside the body that meets no boundary is outside the stone by rounding,
-        // where the population's discs are not part of it).
-        let mut hidden: Option<Hit> = None;
-        // The medium's numbers for this segment (slot-addressed: drawing them first changes
-        // nothing) and, without statistical flakes, its sampled collision: a platelet beyond it
-        // is never met first (the free flight below scatters before it either way), so the grid
-        // walk stops there.
-        let flight = world.medium.then(|| {
-            let u = sampler.get2d_at(slots::medium(path.depth));
-            let hero = *path
-                .hero
-                .get_or_insert(((u.x * S::CHANNELS as f32) as usize).min(S::CHANNELS - 1));
-            (u, hero)
-        });
-        let collision = match flight {
-            Some((u, hero)) if world.flakes.is_none() && !world.platelets.is_empty() => {
-                world.media[usize::from(path.medium.0)].collision::<S>(hero, u.y, &path.lambda)
-            }
-            _ => f32::INFINITY,
-        };
-        if !world.platelets.is_empty()
-            && path.medium == world.interior
-            && let Some(t_max) = found.as_ref().map(Hit::t)
-            && let Some(h) = world.platelet_hit(&ray, t_max.min(collision), path.platelet)
-        {
-            hidden = found.replace(h);
-        }
-        if let Some(flakes) = &world.flakes
-            && path.medium == world.interior
-            && let Some(t_max) = found.as_ref().map(Hit::t)
-        {
-            let u = sampler.get2d_at(slots::platelet(path.depth));
-            if let Some(c) = flakes.collide(ray.origin, ray.dir, t_max, u) {
-                hidden = found.replace(Hit::Platelet {
-                    t: c.t,
-                    p: ray.at(c.t),
-                    n: c.normal,
-                    material: c.material,
-                    id: crate::platelet::PlateletId {
-                        population: u32::MAX,
-                        cell: [0; 3],
-                        index: 0,
-                    },
-                });
-            }
-        }
+        let Meeting { hidden, flight } = meet(world, &ray, &mut path, sampler, &mut found);
         // A pleochroic crystal absorbs by the wave the segment carries (polarised transport).
         let pleochroic = POL
             .then(|| pleochroic_segment(world, path.medium, sampler))
@@ -215,40 +170,11 @@ where
                         && setup.inside
                         && strategy != Strategy::BsdfOnly
                     {
-                        let (u_light, u_point, u_more) =
-                            (sampler.get1d(), sampler.get2d(), sampler.get2d());
-                        let v = WalkVertex {
-                            p,
-                            chain: Chain::Out,
-                            skip: None,
-                            ng: Vec3::ZERO,
-                        };
-                        let u = WalkNumbers {
-                            light: u_light,
-                            point: u_point,
-                            map: [u_more.x; 2],
-                            walk: u_more.y,
-                        };
-                        if let Some(ml) =
-                            manifold::sample_light::<S>(world, setup, &v, &u, &path.lambda)
-                        {
-                            let f = phase.value(-ray.dir, ml.d);
-                            let w = manifold_weight(strategy, ml.pdf, f * ml.cross, true);
-                            let c = path.throughput() * ml.value * (f * w);
-                            if c.is_valid() {
-                                let added = path.gather(c);
-                                if STOKES {
-                                    stokes_add(&mut aov, added);
-                                }
-                            }
-                        }
-                        path.manifold = Some(ManifoldVertex {
-                            p,
-                            d: ps.wi,
-                            pdf: ps.pdf,
-                            chain: Chain::Out,
-                            crossings: 0,
-                        });
+                        let at = (p, ray.dir);
+                        let v = medium_vertex_light::<S, STOKES>(
+                            world, setup, strategy, sampler, at, &phase, &ps, &mut path, &mut aov,
+                        );
+                        path.manifold = Some(v);
                     }
                     path.scatter_in_medium(ps.pdf, p);
                     if POL {

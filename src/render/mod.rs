@@ -32,6 +32,7 @@ mod passes;
 pub mod path;
 mod polarised;
 mod prefilter;
+mod segment;
 pub mod setup;
 pub mod shading;
 pub mod study;
