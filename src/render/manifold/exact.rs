@@ -219,18 +219,7 @@ mod tests {
 
     /// A clear body of IOR 1.5 in the stone `shape`, under a disc light at height 4.
     fn world(shape: &str) -> World {
-        let text = format!(
-            "(materials: {{ \"m\": (coats: [], base: Lambert(albedo: Gray(0.5))) }},
-              body: (ior: 1.5), surface: Body,
-              stage: (shape: {shape},
-                      lights: [Disc(center: (0.0, 4.0, 0.0), target: (0.0, 0.0, 0.0),
-                                    radius: 0.5, radiance: Gray(20.0))]))"
-        );
-        let scene = crate::recipe::GemRecipe::parse("t.ron", &text)
-            .unwrap()
-            .compile()
-            .unwrap();
-        World::new(&scene).unwrap()
+        super::super::test_world(shape, "(ior: 1.5)")
     }
 
     /// A cabochon with a domed base.

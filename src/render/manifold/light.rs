@@ -268,19 +268,8 @@ mod tests {
     /// A sphere of radius 1 (longest chord 2, bounds diagonal 2√3) whose medium keeps `colour`
     /// over `distance`, under a disc light.
     fn world(colour: f32, distance: f32) -> World {
-        let text = format!(
-            "(materials: {{ \"m\": (coats: [], base: Lambert(albedo: Gray(0.5))) }},
-              body: (ior: 1.5, medium: (colour: Gray({colour}), distance: {distance})),
-              surface: Body,
-              stage: (shape: Sphere(radius: 1.0),
-                      lights: [Disc(center: (0.0, 4.0, 0.0), target: (0.0, 0.0, 0.0),
-                                    radius: 0.5, radiance: Gray(20.0))]))"
-        );
-        let scene = crate::recipe::GemRecipe::parse("t.ron", &text)
-            .unwrap()
-            .compile()
-            .unwrap();
-        World::new(&scene).unwrap()
+        let body = format!("(ior: 1.5, medium: (colour: Gray({colour}), distance: {distance}))");
+        super::super::test_world("Sphere(radius: 1.0)", &body)
     }
 
     /// Where the bound says every walk runs, tracing the straight line gives probability 1 for
