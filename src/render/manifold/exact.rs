@@ -219,7 +219,7 @@ mod tests {
 
     /// A clear body of IOR 1.5 in the stone `shape`, under a disc light at height 4.
     fn world(shape: &str) -> World {
-        super::super::test_world(shape, "(ior: 1.5)")
+        super::super::test_scene::test_world(shape, "(ior: 1.5)")
     }
 
     /// A cabochon with a domed base.

@@ -269,7 +269,7 @@ mod tests {
     /// over `distance`, under a disc light.
     fn world(colour: f32, distance: f32) -> World {
         let body = format!("(ior: 1.5, medium: (colour: Gray({colour}), distance: {distance}))");
-        super::super::test_world("Sphere(radius: 1.0)", &body)
+        super::super::test_scene::test_world("Sphere(radius: 1.0)", &body)
     }
 
     /// Where the bound says every walk runs, tracing the straight line gives probability 1 for
